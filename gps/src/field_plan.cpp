@@ -1,0 +1,2 @@
+// Implemented in a later step.
+#include "fieldrig/gps/field_plan.h"

@@ -1,0 +1,1 @@
+#include "fieldrig/gps/location_map.h"

@@ -1,0 +1,18 @@
+// The `fieldrig` CLI's subcommands. Each register function adds its subcommand (and options) to
+// the app and binds a run function; run functions return the process exit code.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace fieldrig::tools {
+
+// Exit codes shared by all subcommands.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitBadInput = 2;    // a file or option that cannot be used
+inline constexpr int kExitRuntime = 3;     // a failure while running (device lost for good…)
+
+void registerNmeaCommand(CLI::App& app, int& exit_code);
+void registerMapCommand(CLI::App& app, int& exit_code);
+void registerTriggersCommand(CLI::App& app, int& exit_code);
+
+}  // namespace fieldrig::tools
