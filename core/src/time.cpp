@@ -7,8 +7,10 @@ namespace fieldrig::core {
 namespace {
 
 std::string fractionText(std::int64_t nanos, int digits) {
-  if (digits <= 0) return {};
-  if (digits > 9) digits = 9;
+  if (digits <= 0)
+    return {};
+  if (digits > 9)
+    digits = 9;
   char buffer[16];
   std::snprintf(buffer, sizeof buffer, ".%09lld", static_cast<long long>(nanos));
   return std::string(buffer, static_cast<std::size_t>(digits) + 1);
@@ -27,10 +29,10 @@ std::string formatIso8601(UtcTime t, int fraction_digits) {
   const year_month_day ymd{day};
   const hh_mm_ss hms{t - day};
   char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%04d-%02u-%02uT%02d:%02d:%02d", static_cast<int>(ymd.year()),
-                static_cast<unsigned>(ymd.month()), static_cast<unsigned>(ymd.day()),
-                static_cast<int>(hms.hours().count()), static_cast<int>(hms.minutes().count()),
-                static_cast<int>(hms.seconds().count()));
+  std::snprintf(buffer, sizeof buffer, "%04d-%02u-%02uT%02d:%02d:%02d",
+                static_cast<int>(ymd.year()), static_cast<unsigned>(ymd.month()),
+                static_cast<unsigned>(ymd.day()), static_cast<int>(hms.hours().count()),
+                static_cast<int>(hms.minutes().count()), static_cast<int>(hms.seconds().count()));
   return std::string(buffer) + fractionText(hms.subseconds().count(), fraction_digits) + "Z";
 }
 
@@ -56,15 +58,19 @@ std::optional<UtcTime> parseIso8601(std::string_view text) {
       !parseInt(text.substr(14, 2), mi) || !parseInt(text.substr(17, 2), s)) {
     return std::nullopt;
   }
-  const year_month_day ymd{year{y}, month{static_cast<unsigned>(mo)}, day{static_cast<unsigned>(d)}};
-  if (!ymd.ok() || h > 23 || mi > 59 || s > 60) return std::nullopt;
+  const year_month_day ymd{year{y}, month{static_cast<unsigned>(mo)},
+                           day{static_cast<unsigned>(d)}};
+  if (!ymd.ok() || h > 23 || mi > 59 || s > 60)
+    return std::nullopt;
   std::int64_t nanos = 0;
   const std::string_view rest = text.substr(19, text.size() - 20);
   if (!rest.empty()) {
-    if (rest.front() != '.' || rest.size() < 2 || rest.size() > 10) return std::nullopt;
+    if (rest.front() != '.' || rest.size() < 2 || rest.size() > 10)
+      return std::nullopt;
     std::int64_t scale = 100'000'000;
     for (char c : rest.substr(1)) {
-      if (c < '0' || c > '9') return std::nullopt;
+      if (c < '0' || c > '9')
+        return std::nullopt;
       nanos += (c - '0') * scale;
       scale /= 10;
     }

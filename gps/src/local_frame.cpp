@@ -24,8 +24,10 @@ GeodeticPoint LocalFrame::toGeodetic(const EnuPoint& point) const {
 
 double bearingDegrees(double east, double north) {
   double degrees = std::atan2(east, north) * 180.0 / std::numbers::pi;
-  if (degrees < 0) degrees += 360.0;
-  if (degrees >= 360.0) degrees -= 360.0;
+  if (degrees < 0)
+    degrees += 360.0;
+  if (degrees >= 360.0)
+    degrees -= 360.0;
   return degrees;
 }
 

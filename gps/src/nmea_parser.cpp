@@ -19,17 +19,28 @@ struct Fields {
 
 Fields splitFields(std::string_view payload) {
   Fields fields;
+  const char* const data = payload.data();
   std::size_t start = 0;
-  while (fields.count < kMaxFields) {
-    const std::size_t comma = payload.find(',', start);
-    if (comma == std::string_view::npos) {
-      fields.values[fields.count++] = payload.substr(start);
-      break;
-    }
-    fields.values[fields.count++] = payload.substr(start, comma - start);
-    start = comma + 1;
+  // A plain loop: this runs for every sentence, and the fields are short.
+  for (std::size_t i = 0; i < payload.size(); ++i) {
+    if (data[i] != ',') continue;
+    fields.values[fields.count++] = std::string_view(data + start, i - start);
+    start = i + 1;
+    if (fields.count == kMaxFields) return fields;
   }
+  fields.values[fields.count++] = std::string_view(data + start, payload.size() - start);
   return fields;
+}
+
+bool isSentenceStart(char c) { return c == '$' || c == '!'; }
+
+// Index of the next '$' or '!' at or after `from`, or npos. (string_view::find_first_of calls
+// memchr once per byte, which made it the parser's hottest spot.)
+std::size_t findSentenceStart(std::string_view line, std::size_t from) {
+  for (std::size_t i = from; i < line.size(); ++i) {
+    if (isSentenceStart(line[i])) return i;
+  }
+  return std::string_view::npos;
 }
 
 int hexValue(char c) {
@@ -46,6 +57,24 @@ bool isDigits(std::string_view text) {
   return true;
 }
 
+// "[-]digits[.digits]": from_chars alone would also take "nan", "inf" and exponents, which no
+// receiver sends and which must not become a speed or a coordinate.
+bool isPlainDecimal(std::string_view text) {
+  if (!text.empty() && text.front() == '-') text.remove_prefix(1);
+  bool digit_seen = false;
+  bool dot_seen = false;
+  for (char c : text) {
+    if (c >= '0' && c <= '9') {
+      digit_seen = true;
+    } else if (c == '.' && !dot_seen) {
+      dot_seen = true;
+    } else {
+      return false;
+    }
+  }
+  return digit_seen;
+}
+
 // Field decoders: return false when the field is present but cannot be decoded (the sentence is
 // then rejected as malformed); an empty field leaves the optional empty.
 bool decodeDouble(std::string_view text, std::optional<double>& out) {
@@ -53,6 +82,7 @@ bool decodeDouble(std::string_view text, std::optional<double>& out) {
   double value = 0;
   // from_chars does not accept a leading '+', which some receivers send.
   if (text.front() == '+') text.remove_prefix(1);
+  if (!isPlainDecimal(text)) return false;
   const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
   if (ec != std::errc() || ptr != text.data() + text.size()) return false;
   out = value;
@@ -79,7 +109,10 @@ bool decodeCoordinate(std::string_view value, std::string_view hemisphere, int m
   if (integer_digits < 3 || integer_digits > 5) return false;
   const std::string_view degree_text = value.substr(0, integer_digits - 2);
   const std::string_view minute_text = value.substr(integer_digits - 2);
-  if (!isDigits(degree_text) || !isDigits(minute_text.substr(0, 2))) return false;
+  if (!isDigits(degree_text) || !isDigits(minute_text.substr(0, 2)) ||
+      !isPlainDecimal(minute_text)) {
+    return false;
+  }
   int degrees = 0;
   std::from_chars(degree_text.data(), degree_text.data() + degree_text.size(), degrees);
   double minutes = 0;
@@ -216,7 +249,12 @@ std::uint64_t NmeaStats::rejectedTotal() const {
 }
 
 NmeaParser::NmeaParser(Handler handler, std::size_t max_line_length)
-    : handler_(std::move(handler)), max_line_length_(max_line_length) {
+    : NmeaParser(std::move(handler), NmeaParserOptions{max_line_length, false}) {}
+
+NmeaParser::NmeaParser(Handler handler, const NmeaParserOptions& options)
+    : handler_(std::move(handler)),
+      max_line_length_(options.max_line_length),
+      comment_lines_(options.comment_lines) {
   pending_.reserve(max_line_length_ + 1);
 }
 
@@ -226,20 +264,22 @@ Sentence NmeaParser::parseLine(std::string_view line) {
   if (line.empty() || (line.front() != '$' && line.front() != '!')) {
     return rejected(line, RejectReason::kGarbage);
   }
-  for (char c : line) {
-    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) {
-      return rejected(line, RejectReason::kNonPrintable);
-    }
-  }
   const std::size_t star = line.rfind('*');
+  // One pass for both the printable check and the checksum (XOR of the bytes between the start
+  // character and '*').
+  unsigned char checksum = 0;
+  const std::size_t checksum_end = star == std::string_view::npos ? 0 : star;
+  for (std::size_t i = 1; i < line.size(); ++i) {
+    const auto c = static_cast<unsigned char>(line[i]);
+    if (c < 0x20 || c > 0x7e) return rejected(line, RejectReason::kNonPrintable);
+    if (i < checksum_end) checksum ^= c;
+  }
   if (star == std::string_view::npos || star + 3 != line.size()) {
     return rejected(line, RejectReason::kNoChecksum);
   }
   const int high = hexValue(line[star + 1]);
   const int low = hexValue(line[star + 2]);
   if (high < 0 || low < 0) return rejected(line, RejectReason::kNoChecksum);
-  unsigned char checksum = 0;
-  for (std::size_t i = 1; i < star; ++i) checksum ^= static_cast<unsigned char>(line[i]);
   if (checksum != static_cast<unsigned char>(high * 16 + low)) {
     return rejected(line, RejectReason::kBadChecksum);
   }
@@ -294,17 +334,32 @@ void NmeaParser::emit(const Sentence& sentence) {
   if (handler_) handler_(sentence);
 }
 
+void NmeaParser::overlong(std::string_view line) {
+  ++stats_.lines;
+  if (comment_lines_ && line.front() == '#') {
+    ++stats_.comments;
+  } else {
+    emit(rejected(line.substr(0, max_line_length_), RejectReason::kTooLong));
+  }
+}
+
 void NmeaParser::processLine(std::string_view line) {
+  // Decided before the blank-line check so that a line's fate never depends on how it was split
+  // into chunks: feed() must judge an over-long line before it has seen all of it.
+  if (line.size() > max_line_length_) {
+    overlong(line);
+    return;
+  }
   // Blank lines (the LF of a CR/LF pair, keep-alives) are not data.
   if (line.find_first_not_of(' ') == std::string_view::npos) return;
   ++stats_.lines;
-  if (line.size() > max_line_length_) {
-    emit(rejected(line.substr(0, max_line_length_), RejectReason::kTooLong));
+  if (comment_lines_ && line.front() == '#') {
+    ++stats_.comments;
     return;
   }
   // A sentence starts at each '$' or '!': text before the first is garbage (NUL runs, escape
   // codes), and a fragment cut short by the next start fails on its missing checksum.
-  std::size_t start = line.find_first_of("$!");
+  std::size_t start = findSentenceStart(line, 0);
   if (start == std::string_view::npos) {
     emit(rejected(line, RejectReason::kGarbage));
     return;
@@ -316,7 +371,7 @@ void NmeaParser::processLine(std::string_view line) {
     }
   }
   while (start != std::string_view::npos) {
-    const std::size_t next = line.find_first_of("$!", start + 1);
+    const std::size_t next = findSentenceStart(line, start + 1);
     emit(parseLine(line.substr(start, next == std::string_view::npos ? next : next - start)));
     start = next;
   }
@@ -332,9 +387,7 @@ void NmeaParser::feed(std::string_view bytes) {
       if (discarding_) return;
       pending_.append(bytes.substr(pos));
       if (pending_.size() > max_line_length_) {
-        ++stats_.lines;
-        emit(rejected(std::string_view(pending_).substr(0, max_line_length_),
-                      RejectReason::kTooLong));
+        overlong(pending_);
         pending_.clear();
         discarding_ = true;
       }

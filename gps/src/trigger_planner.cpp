@@ -1,2 +1,401 @@
-// Implemented in a later step.
 #include "fieldrig/gps/trigger_planner.h"
+
+#include <algorithm>
+#include <boost/geometry.hpp>
+#include <boost/geometry/geometries/box.hpp>
+#include <boost/geometry/geometries/point.hpp>
+#include <boost/geometry/index/rtree.hpp>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace fieldrig::gps {
+namespace {
+
+namespace bg = boost::geometry;
+namespace bgi = boost::geometry::index;
+using IndexPoint = bg::model::point<double, 2, bg::cs::cartesian>;
+using IndexBox = bg::model::box<IndexPoint>;
+using IndexEntry = std::pair<IndexPoint, std::size_t>;
+// R*-tree bulk-loaded once; a season's 100,000 locations answer a box query in microseconds.
+using LocationIndex = bgi::rtree<IndexEntry, bgi::rstar<16>>;
+
+constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
+// A fit needs this many fixes; three is the fewest that still averages some noise.
+constexpr std::size_t kMinFitSamples = 3;
+constexpr core::Nanoseconds kDecisionTime = std::chrono::microseconds{1};
+
+struct Target {
+  EnuPoint position;
+  bool has_heading = false;
+  double heading_east = 0;  // unit vector of the required direction of travel
+  double heading_north = 0;
+  bool armed = true;
+};
+
+struct Sample {
+  double t = 0;  // seconds since the planner's time origin
+  double east = 0;
+  double north = 0;
+};
+
+struct Track {
+  double t = 0;                // time of the newest fix the track was fitted to
+  double east = 0, north = 0;  // fitted position at t
+  double velocity_east = 0, velocity_north = 0;
+  double speed = 0;
+  double unit_east = 0, unit_north = 0;  // direction of travel
+  double course_deg = 0;
+};
+
+struct Plan {
+  std::size_t target = 0;
+  core::UtcTime time{};       // when to fire
+  core::UtcTime predicted{};  // the predicted crossing
+  core::TriggerStatus status = core::TriggerStatus::kOnTime;
+  double speed = 0;
+  double course_deg = 0;
+  double cross_track = 0;
+  core::UtcTime last_fix_time{};
+};
+
+// Least-squares constant-velocity fit of the samples [first, end); nullopt when degenerate.
+std::optional<Track> fitTrack(const std::deque<Sample>& samples, std::size_t first,
+                              double* residual_rms) {
+  const std::size_t n = samples.size() - first;
+  if (n < kMinFitSamples)
+    return std::nullopt;
+  double mean_t = 0, mean_e = 0, mean_n = 0;
+  for (std::size_t i = first; i < samples.size(); ++i) {
+    mean_t += samples[i].t;
+    mean_e += samples[i].east;
+    mean_n += samples[i].north;
+  }
+  mean_t /= static_cast<double>(n);
+  mean_e /= static_cast<double>(n);
+  mean_n /= static_cast<double>(n);
+  double stt = 0, ste = 0, stn = 0;
+  for (std::size_t i = first; i < samples.size(); ++i) {
+    const double dt = samples[i].t - mean_t;
+    stt += dt * dt;
+    ste += dt * (samples[i].east - mean_e);
+    stn += dt * (samples[i].north - mean_n);
+  }
+  if (stt <= 0)
+    return std::nullopt;
+  Track track;
+  track.velocity_east = ste / stt;
+  track.velocity_north = stn / stt;
+  double sum_squares = 0;
+  for (std::size_t i = first; i < samples.size(); ++i) {
+    const double dt = samples[i].t - mean_t;
+    const double re = samples[i].east - (mean_e + track.velocity_east * dt);
+    const double rn = samples[i].north - (mean_n + track.velocity_north * dt);
+    sum_squares += re * re + rn * rn;
+  }
+  *residual_rms = std::sqrt(sum_squares / static_cast<double>(n));
+  track.t = samples.back().t;
+  track.east = mean_e + track.velocity_east * (track.t - mean_t);
+  track.north = mean_n + track.velocity_north * (track.t - mean_t);
+  track.speed = std::hypot(track.velocity_east, track.velocity_north);
+  if (track.speed > 0) {
+    track.unit_east = track.velocity_east / track.speed;
+    track.unit_north = track.velocity_north / track.speed;
+  }
+  track.course_deg = bearingDegrees(track.velocity_east, track.velocity_north);
+  return track;
+}
+
+}  // namespace
+
+struct TriggerPlanner::State {
+  State(const LocationMap& location_map, const TriggerOptions& planner_options)
+      : map(location_map),
+        options(planner_options),
+        frame(location_map.locations().front().latitude_deg,
+              location_map.locations().front().longitude_deg) {}
+
+  const LocationMap& map;
+  TriggerOptions options;
+  LocalFrame frame;  // anchored at the map's first location
+  std::vector<Target> targets;
+  LocationIndex index;
+  std::vector<std::size_t> fired;  // targets waiting to be re-armed
+
+  std::optional<core::UtcTime> origin;  // time zero of Sample::t
+  std::optional<core::UtcTime> last_fix_time;
+  std::deque<Sample> samples;
+  std::optional<Track> track;
+  std::vector<Plan> plans;  // sorted by time
+  std::optional<core::UtcTime> last_trigger_time;
+  std::uint64_t next_trigger_id = 1;
+  TriggerStats stats;
+  std::vector<PlannerAlarm> alarms;
+
+  double seconds(core::UtcTime t) const { return core::toSeconds(t - *origin); }
+  core::UtcTime timeAt(double seconds_since_origin) const {
+    return *origin + core::fromSeconds(seconds_since_origin);
+  }
+
+  void restartTrack() {
+    if (!samples.empty())
+      ++stats.track_restarts;
+    samples.clear();
+    track.reset();
+    plans.clear();
+  }
+
+  void rearm(const EnuPoint& position) {
+    std::erase_if(fired, [&](std::size_t i) {
+      Target& target = targets[i];
+      if (std::hypot(target.position.east_m - position.east_m,
+                     target.position.north_m - position.north_m) > options.rearm_distance_m) {
+        target.armed = true;
+        return true;
+      }
+      return false;
+    });
+  }
+
+  void markFired(std::size_t i) {
+    targets[i].armed = false;
+    fired.push_back(i);
+  }
+
+  void fitAdaptively() {
+    track.reset();
+    std::size_t first = 0;
+    while (samples.size() - first >= kMinFitSamples) {
+      double rms = 0;
+      std::optional<Track> candidate = fitTrack(samples, first, &rms);
+      if (!candidate)
+        return;
+      if (rms <= options.fit_residual_limit_m || samples.size() - first == kMinFitSamples) {
+        // Accept the shortest window only when it also fits; otherwise the motion is not
+        // straight enough (tight turn) to predict from.
+        if (rms <= options.fit_residual_limit_m)
+          track = candidate;
+        return;
+      }
+      // Residuals too large: the older fixes belong to a turn. Keep the newer two thirds.
+      const std::size_t remaining = samples.size() - first;
+      first += std::max<std::size_t>(1, remaining / 3);
+      if (samples.size() - first < kMinFitSamples)
+        first = samples.size() - kMinFitSamples;
+    }
+  }
+
+  void plan(core::UtcTime now, double travelled_since_previous) {
+    plans.clear();
+    const Track& tr = *track;
+    const double right_east = tr.unit_north;  // clockwise normal of the direction of travel
+    const double right_north = -tr.unit_east;
+    const double tolerance = options.cross_track_tolerance_m;
+    const double behind = options.late_tolerance_m + travelled_since_previous + tolerance;
+    const double ahead = tr.speed * (options.max_fix_gap_s + options.trigger_lead_s) + tolerance;
+    const double cos_heading_tolerance =
+        std::cos(options.heading_tolerance_deg / kDegreesPerRadian);
+
+    const double back_e = tr.east - tr.unit_east * behind,
+                 back_n = tr.north - tr.unit_north * behind;
+    const double front_e = tr.east + tr.unit_east * ahead,
+                 front_n = tr.north + tr.unit_north * ahead;
+    const IndexBox box(
+        IndexPoint(std::min(back_e, front_e) - tolerance, std::min(back_n, front_n) - tolerance),
+        IndexPoint(std::max(back_e, front_e) + tolerance, std::max(back_n, front_n) + tolerance));
+    candidates.clear();
+    index.query(bgi::intersects(box), std::back_inserter(candidates));
+
+    const core::UtcTime fix_time = timeAt(tr.t);
+    for (const IndexEntry& entry : candidates) {
+      const std::size_t i = entry.second;
+      const Target& target = targets[i];
+      if (!target.armed)
+        continue;
+      if (target.has_heading &&
+          target.heading_east * tr.unit_east + target.heading_north * tr.unit_north <
+              cos_heading_tolerance) {
+        continue;
+      }
+      const double de = target.position.east_m - tr.east;
+      const double dn = target.position.north_m - tr.north;
+      const double along = de * tr.unit_east + dn * tr.unit_north;
+      const double cross = de * right_east + dn * right_north;
+      if (std::abs(cross) > tolerance)
+        continue;
+      if (along < -options.late_tolerance_m) {
+        if (along >= -behind) {
+          // Passed since the previous fix without a plan (no track then): report, don't fire.
+          ++stats.missed;
+          alarms.push_back({AlarmKind::kMissed, map.locations()[i].id, fix_time,
+                            "location passed without a trigger (no usable track in time)"});
+          markFired(i);
+        }
+        continue;
+      }
+      Plan p;
+      p.target = i;
+      p.predicted = timeAt(tr.t + along / tr.speed - options.trigger_lead_s);
+      p.time = p.predicted;
+      if (p.time < now) {
+        p.time = now;  // noticed after the moment: fire at once, flagged
+        p.status = core::TriggerStatus::kLate;
+      }
+      // A decision cannot fire at the very instant of the fix it rests on (zero latency).
+      p.time = std::max(p.time, fix_time + kDecisionTime);
+      p.speed = tr.speed;
+      p.course_deg = tr.course_deg;
+      p.cross_track = cross;  // + = location to the right of travel
+      p.last_fix_time = fix_time;
+      plans.push_back(p);
+    }
+    std::sort(plans.begin(), plans.end(),
+              [](const Plan& a, const Plan& b) { return a.time < b.time; });
+  }
+
+  std::vector<IndexEntry> candidates;  // reused across queries
+};
+
+TriggerPlanner::TriggerPlanner(const LocationMap& map, TriggerOptions options) {
+  if (map.empty())
+    throw std::invalid_argument("the imaging-location map has no locations");
+  state_ = std::make_unique<State>(map, options);
+  std::vector<IndexEntry> entries;
+  entries.reserve(map.size());
+  state_->targets.reserve(map.size());
+  for (const ImagingLocation& location : map.locations()) {
+    Target target;
+    target.position = state_->frame.toLocal(location.latitude_deg, location.longitude_deg);
+    if (location.heading_deg) {
+      const double radians = *location.heading_deg / kDegreesPerRadian;
+      target.has_heading = true;
+      target.heading_east = std::sin(radians);
+      target.heading_north = std::cos(radians);
+    }
+    entries.emplace_back(IndexPoint(target.position.east_m, target.position.north_m),
+                         state_->targets.size());
+    state_->targets.push_back(target);
+  }
+  state_->index = LocationIndex(entries.begin(), entries.end());
+}
+
+TriggerPlanner::~TriggerPlanner() = default;
+TriggerPlanner::TriggerPlanner(TriggerPlanner&&) noexcept = default;
+TriggerPlanner& TriggerPlanner::operator=(TriggerPlanner&&) noexcept = default;
+
+void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
+  State& s = *state_;
+  ++s.stats.fixes;
+  if (s.last_fix_time && fix.time <= *s.last_fix_time) {
+    ++s.stats.fixes_out_of_order;
+    return;
+  }
+  s.last_fix_time = fix.time;
+  if (!s.origin)
+    s.origin = fix.time;
+  if (!fix.valid) {
+    ++s.stats.fixes_invalid;
+    s.restartTrack();
+    return;
+  }
+  const double t = s.seconds(fix.time);
+  double travelled_since_previous = 0;
+  if (!s.samples.empty() && t - s.samples.back().t > s.options.max_fix_gap_s)
+    s.restartTrack();
+  const EnuPoint position = s.frame.toLocal(fix.latitude_deg, fix.longitude_deg);
+  if (!s.samples.empty()) {
+    travelled_since_previous = std::hypot(position.east_m - s.samples.back().east,
+                                          position.north_m - s.samples.back().north);
+  }
+  s.samples.push_back({t, position.east_m, position.north_m});
+  while (s.samples.size() > kMinFitSamples &&
+         t - s.samples.front().t > s.options.fit_window_s + 1e-6) {
+    s.samples.pop_front();
+  }
+  s.rearm(position);
+  s.fitAdaptively();
+  if (!s.track) {
+    s.plans.clear();
+    return;
+  }
+  if (s.track->speed < s.options.min_speed_mps) {
+    ++s.stats.fixes_too_slow;
+    s.plans.clear();
+    return;
+  }
+  s.plan(now, travelled_since_previous);
+}
+
+std::optional<core::UtcTime> TriggerPlanner::nextTriggerTime() const {
+  const State& s = *state_;
+  if (s.plans.empty())
+    return std::nullopt;
+  core::UtcTime next = s.plans.front().time;
+  if (s.last_trigger_time) {
+    next =
+        std::max(next, *s.last_trigger_time + core::fromSeconds(s.options.min_trigger_interval_s));
+  }
+  return next;
+}
+
+std::vector<core::TriggerEvent> TriggerPlanner::collectDue(core::UtcTime now) {
+  State& s = *state_;
+  std::vector<core::TriggerEvent> events;
+  if (s.plans.empty())
+    return events;
+  if (now - *s.last_fix_time > core::fromSeconds(s.options.max_fix_age_s)) {
+    // The plan rests on a fix too old to extrapolate from: the receiver stalled.
+    s.stats.stale_plans_dropped += s.plans.size();
+    s.plans.clear();
+    return events;
+  }
+  const core::Nanoseconds min_interval = core::fromSeconds(s.options.min_trigger_interval_s);
+  std::size_t done = 0;
+  for (; done < s.plans.size(); ++done) {
+    Plan& p = s.plans[done];
+    core::UtcTime fire_at = p.time;
+    if (s.last_trigger_time && fire_at < *s.last_trigger_time + min_interval) {
+      fire_at = *s.last_trigger_time + min_interval;
+    }
+    if (fire_at > now)
+      break;
+    if (fire_at != p.time) {
+      p.status = core::TriggerStatus::kLate;
+      ++s.stats.too_fast;
+      s.alarms.push_back({AlarmKind::kTooFast, s.map.locations()[p.target].id, fire_at,
+                          "driving too fast for the cameras' trigger rate: trigger delayed"});
+    }
+    core::TriggerEvent event;
+    event.trigger_id = s.next_trigger_id++;
+    event.location_id = s.map.locations()[p.target].id;
+    event.time = fire_at;
+    event.planned_time = p.predicted;
+    event.status = p.status;
+    event.speed_mps = p.speed;
+    event.course_deg = p.course_deg;
+    event.cross_track_m = p.cross_track;
+    event.last_fix_time = p.last_fix_time;
+    ++s.stats.triggers;
+    if (p.status == core::TriggerStatus::kLate)
+      ++s.stats.triggers_late;
+    s.last_trigger_time = fire_at;
+    s.markFired(p.target);
+    events.push_back(std::move(event));
+  }
+  s.plans.erase(s.plans.begin(), s.plans.begin() + static_cast<std::ptrdiff_t>(done));
+  return events;
+}
+
+std::vector<PlannerAlarm> TriggerPlanner::takeAlarms() {
+  return std::exchange(state_->alarms, {});
+}
+
+const TriggerStats& TriggerPlanner::stats() const {
+  return state_->stats;
+}
+
+const LocalFrame& TriggerPlanner::frame() const {
+  return state_->frame;
+}
+
+}  // namespace fieldrig::gps

@@ -8,7 +8,8 @@ namespace fieldrig::core {
 namespace {
 
 Result<int> half(int value) {
-  if (value % 2 != 0) return Error{"odd: " + std::to_string(value)};
+  if (value % 2 != 0)
+    return Error{"odd: " + std::to_string(value)};
   return value / 2;
 }
 

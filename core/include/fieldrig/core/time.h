@@ -31,7 +31,9 @@ struct ReceptionStamp {
 };
 
 // Seconds as a double, for arithmetic on short intervals (sub-nanosecond error up to days).
-inline double toSeconds(Nanoseconds d) { return std::chrono::duration<double>(d).count(); }
+inline double toSeconds(Nanoseconds d) {
+  return std::chrono::duration<double>(d).count();
+}
 inline Nanoseconds fromSeconds(double seconds) {
   return std::chrono::round<Nanoseconds>(std::chrono::duration<double>(seconds));
 }

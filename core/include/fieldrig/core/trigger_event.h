@@ -10,8 +10,8 @@
 namespace fieldrig::core {
 
 enum class TriggerStatus {
-  kOnTime,   // fired at the predicted crossing
-  kLate,     // the crossing was noticed after it happened (gap in fixes, rate limit)
+  kOnTime,  // fired at the predicted crossing
+  kLate,    // the crossing was noticed after it happened (gap in fixes, rate limit)
 };
 
 inline std::string_view toString(TriggerStatus status) {
@@ -24,10 +24,10 @@ struct TriggerEvent {
   UtcTime time{};                // GPS time at which the trigger fires
   UtcTime planned_time{};        // the predicted crossing (equals `time` unless late)
   TriggerStatus status = TriggerStatus::kOnTime;
-  double speed_mps = 0;          // estimated ground speed when planned
-  double course_deg = 0;         // estimated course over ground when planned
-  double cross_track_m = 0;      // signed lateral offset of the location (+ = right of travel)
-  UtcTime last_fix_time{};       // the latest fix the plan used (always before `time`)
+  double speed_mps = 0;      // estimated ground speed when planned
+  double course_deg = 0;     // estimated course over ground when planned
+  double cross_track_m = 0;  // signed lateral offset of the location (+ = right of travel)
+  UtcTime last_fix_time{};   // the latest fix the plan used (always before `time`)
 };
 
 }  // namespace fieldrig::core

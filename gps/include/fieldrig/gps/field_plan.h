@@ -29,8 +29,10 @@ struct FieldPlan {
   std::string id_prefix;  // ids are <prefix>R<row>P<plot>, 1-based, zero-padded
 };
 
-// Locations in driving order with metadata columns row, plot, range. Errors name the field of
-// the plan that is wrong (e.g. plots that do not fit in the row).
+// Locations in driving order with metadata columns row (1-based), plot (1-based and unique in
+// the field: (row-1)*plots_per_row + range) and range (1-based position along the field's
+// direction, the P number of the id, whichever way the row is driven). Errors name the field
+// of the plan that is wrong (e.g. plots that do not fit in the row).
 core::Result<LocationMap> generateLocations(const FieldPlan& plan);
 
 }  // namespace fieldrig::gps

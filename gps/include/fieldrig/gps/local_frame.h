@@ -26,7 +26,9 @@ class LocalFrame {
   EnuPoint toLocal(double latitude_deg, double longitude_deg) const;
   GeodeticPoint toGeodetic(const EnuPoint& point) const;
 
-  GeodeticPoint anchor() const { return {cartesian_.LatitudeOrigin(), cartesian_.LongitudeOrigin()}; }
+  GeodeticPoint anchor() const {
+    return {cartesian_.LatitudeOrigin(), cartesian_.LongitudeOrigin()};
+  }
 
  private:
   GeographicLib::LocalCartesian cartesian_;

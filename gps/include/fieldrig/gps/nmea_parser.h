@@ -75,7 +75,8 @@ struct Sentence {
 };
 
 struct NmeaStats {
-  std::uint64_t lines = 0;       // physical lines (and run-together fragments) seen
+  std::uint64_t lines = 0;       // non-blank physical lines seen (run-together sentences: one line)
+  std::uint64_t comments = 0;    // '#' lines, when NmeaParserOptions::comment_lines is on
   std::uint64_t sentences = 0;   // with a correct checksum
   std::uint64_t rmc = 0;
   std::uint64_t gga = 0;
@@ -85,15 +86,24 @@ struct NmeaStats {
   std::uint64_t rejectedTotal() const;
 };
 
+struct NmeaParserOptions {
+  // NMEA allows 82 characters; RTK receivers with many decimals exceed that, so the default
+  // leaves room while still bounding memory against a line that never ends.
+  std::size_t max_line_length = 200;
+  // Captured files (gpsd logs, recordings) start with '#' header lines that are not device data:
+  // when on, such lines are counted in NmeaStats::comments and not passed to the handler. Off by
+  // default because on a live serial line a '#' is line noise like any other garbage.
+  bool comment_lines = false;
+};
+
 class NmeaParser {
  public:
   using Handler = std::function<void(const Sentence&)>;
 
-  // NMEA allows 82 characters; RTK receivers with many decimals exceed that, so the default
-  // leaves room while still bounding memory against a line that never ends.
-  static constexpr std::size_t kDefaultMaxLineLength = 200;
+  static constexpr std::size_t kDefaultMaxLineLength = NmeaParserOptions{}.max_line_length;
 
   explicit NmeaParser(Handler handler, std::size_t max_line_length = kDefaultMaxLineLength);
+  NmeaParser(Handler handler, const NmeaParserOptions& options);
 
   // Consumes a chunk of bytes in arrival order; calls the handler once per completed line
   // (blank lines are skipped silently). A line may span chunks.
@@ -109,10 +119,12 @@ class NmeaParser {
 
  private:
   void processLine(std::string_view line);
+  void overlong(std::string_view line);
   void emit(const Sentence& sentence);
 
   Handler handler_;
   std::size_t max_line_length_;
+  bool comment_lines_ = false;
   std::string pending_;         // a partial line carried over between chunks
   bool discarding_ = false;     // inside an over-long line, dropping bytes until its end
   NmeaStats stats_;

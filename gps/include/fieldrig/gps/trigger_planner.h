@@ -34,11 +34,12 @@ struct TriggerOptions {
   double max_fix_age_s = 0.5;            // a plan older than this is stale and never fires
   double max_fix_gap_s = 0.5;            // a longer gap between fixes restarts the track fit
   double min_trigger_interval_s = 0.25;  // the cameras' maximum rate
-  double late_tolerance_m = 0.3;         // fire late if the crossing was missed by ≤ this; beyond: missed
-  double rearm_distance_m = 3.0;         // a fired location re-arms when the antenna is this far
-  double fit_window_s = 1.0;             // the track is fitted to fixes of this recent span
-  double fit_residual_limit_m = 0.05;    // RMS residual above which the fit window is shortened (turns)
-  double trigger_lead_s = 0.0;           // fire this much before the crossing (camera exposure delay)
+  double late_tolerance_m = 0.3;  // fire late if the crossing was missed by ≤ this; beyond: missed
+  double rearm_distance_m = 3.0;  // a fired location re-arms when the antenna is this far
+  double fit_window_s = 1.0;      // the track is fitted to fixes of this recent span
+  double fit_residual_limit_m =
+      0.05;                     // RMS residual above which the fit window is shortened (turns)
+  double trigger_lead_s = 0.0;  // fire this much before the crossing (camera exposure delay)
 };
 
 enum class AlarmKind {
@@ -55,10 +56,10 @@ struct PlannerAlarm {
 
 struct TriggerStats {
   std::uint64_t fixes = 0;
-  std::uint64_t fixes_invalid = 0;    // RMC status V or GGA quality 0
+  std::uint64_t fixes_invalid = 0;       // RMC status V or GGA quality 0
   std::uint64_t fixes_out_of_order = 0;  // not newer than the previous fix (duplicates of an epoch)
-  std::uint64_t fixes_too_slow = 0;   // below min_speed_mps
-  std::uint64_t track_restarts = 0;   // gaps and invalid fixes
+  std::uint64_t fixes_too_slow = 0;      // below min_speed_mps
+  std::uint64_t track_restarts = 0;      // gaps and invalid fixes
   std::uint64_t triggers = 0;
   std::uint64_t triggers_late = 0;
   std::uint64_t stale_plans_dropped = 0;

@@ -1,0 +1,56 @@
+#include "fieldrig/gps/trigger_replay.h"
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "fieldrig/gps/fix_assembler.h"
+
+namespace fieldrig::gps {
+
+ReplaySummary replayTriggers(std::istream& nmea, const LocationMap& map,
+                             const ReplayOptions& options, const ReplayHandlers& handlers) {
+  TriggerPlanner planner(map, options.planner);
+  FixAssembler assembler;
+  const core::Nanoseconds latency = core::fromSeconds(options.latency_s);
+  std::optional<core::UtcTime> last_available;
+
+  auto publish = [&](core::UtcTime until) {
+    for (const core::TriggerEvent& event : planner.collectDue(until)) {
+      if (handlers.on_trigger)
+        handlers.on_trigger(event);
+    }
+    for (const PlannerAlarm& alarm : planner.takeAlarms()) {
+      if (handlers.on_alarm)
+        handlers.on_alarm(alarm);
+    }
+  };
+
+  // Replayed files carry '#' comment headers (gpsd's format); they are not device data.
+  NmeaParser parser(
+      [&](const Sentence& sentence) {
+        const std::optional<core::GpsFix> fix = assembler.add(sentence, core::ReceptionStamp{});
+        if (!fix)
+          return;
+        const core::UtcTime available = fix->time + latency;
+        // Everything planned before this fix could be used fires first: causality.
+        publish(available - core::Nanoseconds{1});
+        planner.addFix(*fix, available);
+        if (!last_available || available > *last_available)
+          last_available = available;
+        publish(available);
+      },
+      NmeaParser::kDefaultMaxLineLength);
+
+  std::array<char, 65536> chunk{};
+  while (nmea.read(chunk.data(), chunk.size()) || nmea.gcount() > 0) {
+    parser.feed(std::string_view(chunk.data(), static_cast<std::size_t>(nmea.gcount())));
+  }
+  parser.flush();
+  // At the end of the capture the live daemon's timer would still fire what was planned.
+  if (last_available)
+    publish(*last_available + core::fromSeconds(options.planner.max_fix_age_s));
+  return {parser.stats(), planner.stats()};
+}
+
+}  // namespace fieldrig::gps

@@ -1,0 +1,3 @@
+fieldrig_add_test(trigger_planner_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/trigger_planner_test.cpp
+  LIBS fieldrig::gps)

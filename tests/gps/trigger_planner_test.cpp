@@ -1,0 +1,337 @@
+#include "fieldrig/gps/trigger_planner.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <string>
+
+namespace fieldrig::gps {
+namespace {
+
+using namespace std::chrono_literals;
+
+// A point of the test field, anchored at an arbitrary place in Iowa.
+constexpr double kAnchorLat = 42.0;
+constexpr double kAnchorLon = -93.6;
+const core::UtcTime kStart =
+    core::UtcTime{std::chrono::sys_days{std::chrono::year{2026} / std::chrono::July / 14}} + 15h;
+
+class Field {
+ public:
+  Field() : frame_(kAnchorLat, kAnchorLon) {}
+
+  void addLocation(const std::string& id, double east, double north,
+                   std::optional<double> heading = std::nullopt) {
+    const GeodeticPoint p = frame_.toGeodetic({east, north});
+    ImagingLocation location{id, p.latitude_deg, p.longitude_deg, heading, {}};
+    ASSERT_TRUE(map_.add(location).ok());
+  }
+
+  core::GpsFix fixAt(core::UtcTime t, double east, double north, bool valid = true) const {
+    core::GpsFix fix;
+    fix.time = t;
+    fix.has_date = true;
+    const GeodeticPoint p = frame_.toGeodetic({east, north});
+    fix.latitude_deg = p.latitude_deg;
+    fix.longitude_deg = p.longitude_deg;
+    fix.valid = valid;
+    return fix;
+  }
+
+  const LocationMap& map() const { return map_; }
+
+ private:
+  LocalFrame frame_;
+  LocationMap map_;
+};
+
+// Drives due north along east = `east` from north = n0 at `speed`, 10 Hz, calling the planner as
+// the replay does; returns the triggers.
+struct Drive {
+  double east = 0;
+  double north_start = -10;
+  double speed = 2.0;
+  double duration_s = 12;
+  double direction = 1;  // +1 north, -1 south
+  core::UtcTime start = kStart;
+  std::function<bool(int)> valid = [](int) { return true; };
+  std::function<bool(int)> present = [](int) { return true; };
+};
+
+std::vector<core::TriggerEvent> drive(const Field& field, TriggerPlanner& planner, const Drive& d) {
+  std::vector<core::TriggerEvent> all;
+  const int epochs = static_cast<int>(d.duration_s * 10);
+  for (int k = 0; k <= epochs; ++k) {
+    const core::UtcTime t = d.start + k * 100ms;
+    for (auto& e : planner.collectDue(t - 1ns))
+      all.push_back(e);
+    if (!d.present(k))
+      continue;
+    const double north = d.north_start + d.direction * d.speed * 0.1 * k;
+    planner.addFix(field.fixAt(t, d.east, north, d.valid(k)), t);
+    for (auto& e : planner.collectDue(t))
+      all.push_back(e);
+  }
+  return all;
+}
+
+// Smallest difference between two bearings, degrees.
+double angleBetween(double a, double b) {
+  const double d = std::fmod(std::abs(a - b), 360.0);
+  return std::min(d, 360.0 - d);
+}
+
+double crossingNorth(const core::TriggerEvent& e, const Drive& d) {
+  return d.north_start + d.direction * d.speed * core::toSeconds(e.time - d.start);
+}
+
+TEST(TriggerPlannerTest, FiresOncePerLocationAtThePredictedCrossing) {
+  Field field;
+  for (int i = 0; i < 5; ++i)
+    field.addLocation("P" + std::to_string(i), 0.0, 1.3 + 3.7 * i);
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.duration_s = 15;  // north -10 … 20 m
+  const auto events = drive(field, planner, d);
+  ASSERT_EQ(events.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(events[i].location_id, "P" + std::to_string(i));
+    // Noise-free straight drive: the prediction is exact to well under a millimetre.
+    EXPECT_NEAR(crossingNorth(events[i], d), 1.3 + 3.7 * i, 1e-3);
+    EXPECT_EQ(events[i].status, core::TriggerStatus::kOnTime);
+    EXPECT_LT(events[i].last_fix_time, events[i].time);  // causal
+    EXPECT_NEAR(events[i].speed_mps, 2.0, 1e-6);
+    EXPECT_LT(angleBetween(events[i].course_deg, 0.0), 1e-3);
+  }
+  EXPECT_EQ(planner.stats().triggers, 5u);
+  EXPECT_EQ(planner.stats().missed, 0u);
+}
+
+TEST(TriggerPlannerTest, HeadingMustMatchTheDirectionOfTravel) {
+  Field field;
+  field.addLocation("north", 0.0, 2.0, 0.0);
+  field.addLocation("south", 0.0, 4.0, 180.0);
+  field.addLocation("north_east_59", 0.0, 6.0, 59.0);
+  field.addLocation("east_61", 0.0, 8.0, 61.0);
+  field.addLocation("wraps_350", 0.0, 10.0, 350.0);
+  TriggerPlanner planner(field.map(), {});
+  const auto events = drive(field, planner, Drive{});
+  std::vector<std::string> ids;
+  for (const auto& e : events)
+    ids.push_back(e.location_id);
+  EXPECT_EQ(ids, (std::vector<std::string>{"north", "north_east_59", "wraps_350"}));
+}
+
+TEST(TriggerPlannerTest, CrossTrackToleranceSeparatesNeighbouringRows) {
+  Field field;
+  field.addLocation("this_row_right", 0.4, 3.0);
+  field.addLocation("this_row_left", -0.4, 5.0);
+  field.addLocation("next_row", 0.76, 7.0);
+  TriggerPlanner planner(field.map(), {});
+  const auto events = drive(field, planner, Drive{});
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].location_id, "this_row_right");
+  EXPECT_NEAR(events[0].cross_track_m, 0.4, 1e-3);
+  EXPECT_EQ(events[1].location_id, "this_row_left");
+  EXPECT_NEAR(events[1].cross_track_m, -0.4, 1e-3);
+}
+
+TEST(TriggerPlannerTest, InvalidFixesNeverTrigger) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.valid = [](int) { return false; };
+  EXPECT_TRUE(drive(field, planner, d).empty());
+  EXPECT_GT(planner.stats().fixes_invalid, 100u);
+}
+
+TEST(TriggerPlannerTest, InvalidFixJustBeforeTheLocationDropsThePlan) {
+  Field field;
+  field.addLocation("A", 0.0, 5.05);  // crossed at k = 75.25
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.valid = [](int k) { return k < 75 || k > 90; };
+  const auto events = drive(field, planner, d);
+  EXPECT_TRUE(events.empty());
+}
+
+TEST(TriggerPlannerTest, StoppedOrCreepingNeverTriggers) {
+  Field field;
+  field.addLocation("A", 0.0, 0.05);
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.speed = 0.1;  // 10 cm/s, below the 0.3 m/s minimum
+  d.north_start = -0.5;
+  EXPECT_TRUE(drive(field, planner, d).empty());
+  EXPECT_GT(planner.stats().fixes_too_slow, 0u);
+}
+
+TEST(TriggerPlannerTest, StaleFixesDoNotFireOnExtrapolation) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.present = [](int k) { return k < 60; };  // receiver stalls 1.5 s before the location
+  EXPECT_TRUE(drive(field, planner, d).empty());
+}
+
+TEST(TriggerPlannerTest, LocationPassedDuringAGapIsReportedMissed) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.present = [](int k) { return k < 65 || k > 76; };  // 1.2 s gap: the track restarts
+  const auto events = drive(field, planner, d);
+  EXPECT_TRUE(events.empty());
+  EXPECT_EQ(planner.stats().missed, 1u);
+  const auto alarms = planner.takeAlarms();
+  ASSERT_EQ(alarms.size(), 1u);
+  EXPECT_EQ(alarms[0].kind, AlarmKind::kMissed);
+  EXPECT_EQ(alarms[0].location_id, "A");
+}
+
+TEST(TriggerPlannerTest, ShortGapIsBridgedLate) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
+  TriggerOptions options;
+  options.late_tolerance_m = 0.5;
+  options.max_fix_age_s = 0.15;  // a plan may rest on a fix at most 0.15 s old
+  TriggerPlanner planner(field.map(), options);
+  Drive d;
+  d.present = [](int k) { return k < 73 || k > 75; };  // fixes 73-75 lost
+  const auto events = drive(field, planner, d);
+  ASSERT_EQ(events.size(), 1u);
+  // Fix 72 planned the crossing for 7.5 s, but by then its plan was 0.3 s old: dropped. Fix 76
+  // finds the antenna 0.2 m past the location: fired at once, flagged late.
+  EXPECT_EQ(events[0].status, core::TriggerStatus::kLate);
+  // Zero latency here: "at once" is the planner's 1 µs decision time after the fix.
+  EXPECT_EQ(events[0].time, kStart + 7600ms + 1us);
+  EXPECT_EQ(planner.stats().stale_plans_dropped, 1u);
+}
+
+TEST(TriggerPlannerTest, ShortGapIsBridgedOnTimeByExtrapolation) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.present = [](int k) { return k < 73 || k > 75; };
+  const auto events = drive(field, planner, d);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].status, core::TriggerStatus::kOnTime);
+  EXPECT_NEAR(crossingNorth(events[0], d), 5.0, 1e-3);
+}
+
+TEST(TriggerPlannerTest, MinimumIntervalDelaysAndRaisesTooFast) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);
+  field.addLocation("B", 0.0, 5.2);  // 0.1 s later at 2 m/s
+  TriggerOptions options;
+  options.min_trigger_interval_s = 0.25;
+  options.late_tolerance_m = 1.0;
+  TriggerPlanner planner(field.map(), options);
+  const auto events = drive(field, planner, Drive{});
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].status, core::TriggerStatus::kOnTime);
+  EXPECT_EQ(events[1].status, core::TriggerStatus::kLate);
+  EXPECT_EQ(events[1].time - events[0].time, 250ms);
+  EXPECT_EQ(planner.stats().too_fast, 1u);
+  const auto alarms = planner.takeAlarms();
+  ASSERT_FALSE(alarms.empty());
+  EXPECT_EQ(alarms[0].kind, AlarmKind::kTooFast);
+}
+
+TEST(TriggerPlannerTest, FiresAgainOnALaterPass) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);
+  TriggerPlanner planner(field.map(), {});
+  Drive there;
+  const auto first = drive(field, planner, there);
+  Drive back;
+  back.start = kStart + 20s;
+  back.north_start = 15;
+  back.direction = -1;
+  const auto second = drive(field, planner, back);
+  ASSERT_EQ(first.size(), 1u);
+  ASSERT_EQ(second.size(), 1u);
+  EXPECT_NEAR(crossingNorth(second[0], back), 5.0, 1e-3);
+  EXPECT_LT(angleBetween(second[0].course_deg, 180.0), 1e-3);
+}
+
+TEST(TriggerPlannerTest, LatencyIsAccountedForCausally) {
+  Field field;
+  field.addLocation("A", 0.0, 5.01);  // crossed at 7.505 s, 5 ms after fix 75
+  TriggerPlanner planner(field.map(), {});
+  std::vector<core::TriggerEvent> events;
+  const auto latency = 50ms;
+  for (int k = 0; k <= 120; ++k) {
+    const core::UtcTime t = kStart + k * 100ms;
+    for (auto& e : planner.collectDue(t + latency - 1ns))
+      events.push_back(e);
+    planner.addFix(field.fixAt(t, 0.0, -10.0 + 0.2 * k), t + latency);
+    for (auto& e : planner.collectDue(t + latency))
+      events.push_back(e);
+  }
+  ASSERT_EQ(events.size(), 1u);
+  // Fix 75 (7.5 s) is usable only at 7.55 s, after the crossing: the trigger must come from
+  // fix 74, usable at 7.45 s, and still fire at the crossing.
+  EXPECT_EQ(events[0].status, core::TriggerStatus::kOnTime);
+  EXPECT_EQ(events[0].last_fix_time, kStart + 7400ms);
+  EXPECT_NEAR(core::toSeconds(events[0].time - kStart), 7.505, 1e-6);
+}
+
+TEST(TriggerPlannerTest, CrossingBeforeTheFixIsUsableFiresLate) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);
+  TriggerOptions options;
+  options.max_fix_gap_s = 0.05;  // no prediction beyond 50 ms + tolerance of the newest fix
+  options.cross_track_tolerance_m = 0.01;
+  TriggerPlanner planner(field.map(), options);
+  std::vector<core::TriggerEvent> events;
+  // 20 Hz fixes, 80 ms latency: the crossing at 7.5 s is seen from fix 7.45 s (usable at
+  // 7.53 s) only as 0.1 m ahead, beyond the tiny horizon; from fix 7.5 s, usable at 7.58 s, as
+  // just reached: fired at 7.58 s, late.
+  for (int k = 0; k <= 240; ++k) {
+    const core::UtcTime t = kStart + k * 50ms;
+    const core::UtcTime usable = t + 80ms;
+    for (auto& e : planner.collectDue(usable - 1ns))
+      events.push_back(e);
+    planner.addFix(field.fixAt(t, 0.0, -10.0 + 0.1 * k), usable);
+    for (auto& e : planner.collectDue(usable))
+      events.push_back(e);
+  }
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].status, core::TriggerStatus::kLate);
+  EXPECT_EQ(events[0].time, kStart + 7580ms);
+  EXPECT_EQ(events[0].last_fix_time, kStart + 7500ms);
+}
+
+TEST(TriggerPlannerTest, SeasonSizedMapOnlyFiresTheLocationsDriven) {
+  Field field;
+  // 100,000 locations: 400 rows 2.286 m apart, 250 plots 4 m apart.
+  for (int row = 0; row < 400; ++row) {
+    for (int plot = 0; plot < 250; ++plot) {
+      field.addLocation("R" + std::to_string(row) + "P" + std::to_string(plot), row * 2.286,
+                        plot * 4.0 + 2.0);
+    }
+  }
+  ASSERT_EQ(field.map().size(), 100000u);
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.east = 10 * 2.286;  // row 10
+  d.duration_s = 25;    // north -10 … 40 m: plots 0…9
+  const auto events = drive(field, planner, d);
+  ASSERT_EQ(events.size(), 10u);
+  for (int plot = 0; plot < 10; ++plot) {
+    EXPECT_EQ(events[plot].location_id, "R10P" + std::to_string(plot));
+  }
+}
+
+TEST(TriggerPlannerTest, EmptyMapIsAStartUpError) {
+  LocationMap empty;
+  EXPECT_THROW(TriggerPlanner(empty, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace fieldrig::gps
