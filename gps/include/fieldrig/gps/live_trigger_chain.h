@@ -1,0 +1,64 @@
+// The live GPS → trigger chain: sentences with reception stamps in, triggers out at the
+// predicted crossing, on a steady_timer. Owned by one thread: every method and callback runs on
+// the thread running the io_context (the daemon's GPS/trigger thread, which nothing blocks).
+//
+// GPS time and the host's steady clock are related through the fixes' reception stamps:
+// reception = fix time + clock offset + latency. The latency varies (the receiver's computation,
+// serial queueing); its least value over recent fixes is taken to be the configured nominal
+// latency, which fixes the offset, so a trigger planned for GPS time t fires at steady time
+// t + offset.
+#pragma once
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include <deque>
+#include <functional>
+#include <optional>
+
+#include "fieldrig/core/trigger_event.h"
+#include "fieldrig/gps/fix_assembler.h"
+#include "fieldrig/gps/nmea_parser.h"
+#include "fieldrig/gps/trigger_planner.h"
+
+namespace fieldrig::gps {
+
+struct LiveTriggerOptions {
+  TriggerOptions planner;
+  double latency_s = 0.05;  // nominal receiver-and-serial latency (see ReplayOptions)
+};
+
+class LiveTriggerChain {
+ public:
+  using TriggerHandler = std::function<void(const core::TriggerEvent&, core::SteadyTime fired_at)>;
+  using AlarmHandler = std::function<void(const PlannerAlarm&)>;
+  using FixHandler = std::function<void(const core::GpsFix&)>;
+
+  LiveTriggerChain(boost::asio::io_context& io, const LocationMap& map, LiveTriggerOptions options,
+                   TriggerHandler on_trigger, AlarmHandler on_alarm = {}, FixHandler on_fix = {});
+
+  // Feed every sentence as it arrives (SerialNmeaSource's handler).
+  void onSentence(const Sentence& sentence, const core::ReceptionStamp& received);
+
+  void stop();
+
+  // GPS time corresponding to a steady-clock instant; nullopt before the first fix.
+  std::optional<core::UtcTime> gpsTimeAt(core::SteadyTime steady) const;
+  const TriggerPlanner& planner() const { return planner_; }
+
+ private:
+  void armTimer();
+  void fireDue(core::SteadyTime now);
+
+  boost::asio::steady_timer timer_;
+  LiveTriggerOptions options_;
+  TriggerHandler on_trigger_;
+  AlarmHandler on_alarm_;
+  FixHandler on_fix_;
+  FixAssembler assembler_;
+  TriggerPlanner planner_;
+  std::deque<core::Nanoseconds> recent_offsets_;  // reception (steady) − fix time, per fix
+  std::optional<core::Nanoseconds> offset_;       // steady − GPS time
+};
+
+}  // namespace fieldrig::gps

@@ -1,0 +1,73 @@
+#include "fieldrig/gps/live_trigger_chain.h"
+
+#include <algorithm>
+
+namespace fieldrig::gps {
+namespace {
+// Offsets of the last ~5 s of fixes at 10 Hz: long enough to contain a least-delayed fix,
+// short enough to follow the slow drift between the receiver's and the host's clocks.
+constexpr std::size_t kOffsetWindow = 50;
+}  // namespace
+
+LiveTriggerChain::LiveTriggerChain(boost::asio::io_context& io, const LocationMap& map,
+                                   LiveTriggerOptions options, TriggerHandler on_trigger,
+                                   AlarmHandler on_alarm, FixHandler on_fix)
+    : timer_(io),
+      options_(options),
+      on_trigger_(std::move(on_trigger)),
+      on_alarm_(std::move(on_alarm)),
+      on_fix_(std::move(on_fix)),
+      planner_(map, options.planner) {}
+
+std::optional<core::UtcTime> LiveTriggerChain::gpsTimeAt(core::SteadyTime steady) const {
+  if (!offset_) return std::nullopt;
+  return core::UtcTime{steady.time_since_epoch() - *offset_};
+}
+
+void LiveTriggerChain::onSentence(const Sentence& sentence, const core::ReceptionStamp& received) {
+  const std::optional<core::GpsFix> fix = assembler_.add(sentence, received);
+  if (!fix) return;
+  if (on_fix_) on_fix_(*fix);
+  // Fire what was due before this fix arrived: the timer may not have run yet.
+  fireDue(received.steady);
+
+  recent_offsets_.push_back(received.steady.time_since_epoch() - fix->time.time_since_epoch());
+  if (recent_offsets_.size() > kOffsetWindow) recent_offsets_.pop_front();
+  const core::Nanoseconds least_delayed =
+      *std::min_element(recent_offsets_.begin(), recent_offsets_.end());
+  offset_ = least_delayed - core::fromSeconds(options_.latency_s);
+
+  planner_.addFix(*fix, *gpsTimeAt(received.steady));
+  fireDue(received.steady);
+  armTimer();
+}
+
+void LiveTriggerChain::fireDue(core::SteadyTime now) {
+  const std::optional<core::UtcTime> gps_now = gpsTimeAt(now);
+  if (!gps_now) return;
+  for (const core::TriggerEvent& event : planner_.collectDue(*gps_now)) {
+    if (on_trigger_) on_trigger_(event, now);
+  }
+  for (const PlannerAlarm& alarm : planner_.takeAlarms()) {
+    if (on_alarm_) on_alarm_(alarm);
+  }
+}
+
+void LiveTriggerChain::armTimer() {
+  const std::optional<core::UtcTime> next = planner_.nextTriggerTime();
+  if (!next || !offset_) {
+    timer_.cancel();
+    return;
+  }
+  timer_.expires_at(core::SteadyTime{
+      std::chrono::duration_cast<core::SteadyTime::duration>(next->time_since_epoch() + *offset_)});
+  timer_.async_wait([this](const boost::system::error_code& error) {
+    if (error) return;  // cancelled: re-armed by a newer plan, or stopped
+    fireDue(std::chrono::steady_clock::now());
+    armTimer();
+  });
+}
+
+void LiveTriggerChain::stop() { timer_.cancel(); }
+
+}  // namespace fieldrig::gps

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages fieldrig needs, only those that are missing (apt-get as root).
+set -euo pipefail
+
+packages=(
+  g++ cmake ninja-build pkg-config
+  libboost-dev libboost-system-dev
+  libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libgeographiclib-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  socat          # serial tests run through real pseudo-terminals
+  clang libclang-rt-14-dev  # libFuzzer for the NMEA parser fuzz test
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if ((${#missing[@]})); then
+  echo "fieldrig: installing ${missing[*]}" >&2
+  if [[ $(id -u) -ne 0 ]]; then
+    echo "fieldrig: missing packages and not root; run as root or install: ${missing[*]}" >&2
+    exit 1
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -q
+  apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
