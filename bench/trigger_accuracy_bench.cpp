@@ -108,7 +108,7 @@ sim::TriggerAccuracy pool(const std::vector<sim::TriggerAccuracy>& runs) {
 int run(int argc, char** argv) {
   int seeds = 10;
   double noise = 0.01;
-  double latency = 0.0;
+  double latency = gps::ReplayOptions{}.latency_s;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--seeds"))
       seeds = std::atoi(argv[i + 1]);

@@ -34,14 +34,14 @@ struct Field {
   LocationMap map;
 };
 
-// Fixes along row 10, northward at 2 m/s, precomputed so only the planner is timed.
+// Fixes along row 5, northward at 2 m/s, precomputed so only the planner is timed.
 std::vector<core::GpsFix> driveFixes(const LocalFrame& frame, int count) {
   std::vector<core::GpsFix> fixes;
   const core::UtcTime start{std::chrono::sys_days{std::chrono::year{2026} / 7 / 14}};
   for (int k = 0; k < count; ++k) {
     core::GpsFix fix;
     fix.time = start + k * 100ms;
-    const GeodeticPoint p = frame.toGeodetic({10 * kRowSpacing, -5.0 + 0.2 * k});
+    const GeodeticPoint p = frame.toGeodetic({5 * kRowSpacing, -5.0 + 0.2 * k});
     fix.latitude_deg = p.latitude_deg;
     fix.longitude_deg = p.longitude_deg;
     fix.valid = true;

@@ -20,19 +20,23 @@ LiveTriggerChain::LiveTriggerChain(boost::asio::io_context& io, const LocationMa
       planner_(map, options.planner) {}
 
 std::optional<core::UtcTime> LiveTriggerChain::gpsTimeAt(core::SteadyTime steady) const {
-  if (!offset_) return std::nullopt;
+  if (!offset_)
+    return std::nullopt;
   return core::UtcTime{steady.time_since_epoch() - *offset_};
 }
 
 void LiveTriggerChain::onSentence(const Sentence& sentence, const core::ReceptionStamp& received) {
   const std::optional<core::GpsFix> fix = assembler_.add(sentence, received);
-  if (!fix) return;
-  if (on_fix_) on_fix_(*fix);
+  if (!fix)
+    return;
+  if (on_fix_)
+    on_fix_(*fix);
   // Fire what was due before this fix arrived: the timer may not have run yet.
   fireDue(received.steady);
 
   recent_offsets_.push_back(received.steady.time_since_epoch() - fix->time.time_since_epoch());
-  if (recent_offsets_.size() > kOffsetWindow) recent_offsets_.pop_front();
+  if (recent_offsets_.size() > kOffsetWindow)
+    recent_offsets_.pop_front();
   const core::Nanoseconds least_delayed =
       *std::min_element(recent_offsets_.begin(), recent_offsets_.end());
   offset_ = least_delayed - core::fromSeconds(options_.latency_s);
@@ -44,12 +48,15 @@ void LiveTriggerChain::onSentence(const Sentence& sentence, const core::Receptio
 
 void LiveTriggerChain::fireDue(core::SteadyTime now) {
   const std::optional<core::UtcTime> gps_now = gpsTimeAt(now);
-  if (!gps_now) return;
+  if (!gps_now)
+    return;
   for (const core::TriggerEvent& event : planner_.collectDue(*gps_now)) {
-    if (on_trigger_) on_trigger_(event, now);
+    if (on_trigger_)
+      on_trigger_(event, now);
   }
   for (const PlannerAlarm& alarm : planner_.takeAlarms()) {
-    if (on_alarm_) on_alarm_(alarm);
+    if (on_alarm_)
+      on_alarm_(alarm);
   }
 }
 
@@ -62,12 +69,15 @@ void LiveTriggerChain::armTimer() {
   timer_.expires_at(core::SteadyTime{
       std::chrono::duration_cast<core::SteadyTime::duration>(next->time_since_epoch() + *offset_)});
   timer_.async_wait([this](const boost::system::error_code& error) {
-    if (error) return;  // cancelled: re-armed by a newer plan, or stopped
+    if (error)
+      return;  // cancelled: re-armed by a newer plan, or stopped
     fireDue(std::chrono::steady_clock::now());
     armTimer();
   });
 }
 
-void LiveTriggerChain::stop() { timer_.cancel(); }
+void LiveTriggerChain::stop() {
+  timer_.cancel();
+}
 
 }  // namespace fieldrig::gps
