@@ -1,12 +1,17 @@
 // `fieldrig triggers --map MAP.csv --nmea FILE`: replays a capture in GPS time and prints one
 // JSON line per trigger on stdout; alarms and the summary go to stderr as JSON lines.
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "commands/commands.h"
+#include "fieldrig/gps/live_trigger_chain.h"
 #include "fieldrig/gps/location_map.h"
+#include "fieldrig/gps/serial_nmea_source.h"
 #include "fieldrig/gps/trigger_replay.h"
 
 namespace fieldrig::tools {
@@ -17,11 +22,102 @@ using Json = nlohmann::ordered_json;
 struct TriggersArgs {
   std::string map_path;
   std::string nmea_path;
+  unsigned baud = 115200;
   gps::ReplayOptions replay;
 };
 
 std::string_view alarmName(gps::AlarmKind kind) {
   return kind == gps::AlarmKind::kTooFast ? "too_fast" : "missed";
+}
+
+Json triggerJson(const core::TriggerEvent& event) {
+  Json line;
+  line["trigger_id"] = event.trigger_id;
+  line["location"] = event.location_id;
+  line["time"] = core::formatIso8601(event.time, 6);
+  line["status"] = core::toString(event.status);
+  line["predicted_crossing"] = core::formatIso8601(event.planned_time, 6);
+  line["last_fix_time"] = core::formatIso8601(event.last_fix_time, 6);
+  line["speed_mps"] = event.speed_mps;
+  line["course_deg"] = event.course_deg;
+  line["cross_track_m"] = event.cross_track_m;
+  return line;
+}
+
+void printAlarm(const gps::PlannerAlarm& alarm) {
+  Json line;
+  line["alarm"] = alarmName(alarm.kind);
+  line["location"] = alarm.location_id;
+  line["time"] = core::formatIso8601(alarm.time, 6);
+  line["message"] = alarm.message;
+  std::cerr << line.dump() << std::endl;
+}
+
+Json summaryJson(const gps::LocationMap& map, const gps::NmeaStats& nmea,
+                 const gps::TriggerStats& s) {
+  Json out;
+  out["locations"] = map.size();
+  out["sentences"] = nmea.sentences;
+  out["rejected_lines"] = nmea.rejectedTotal();
+  out["fixes"] = s.fixes;
+  out["fixes_invalid"] = s.fixes_invalid;
+  out["fixes_too_slow"] = s.fixes_too_slow;
+  out["track_restarts"] = s.track_restarts;
+  out["triggers"] = s.triggers;
+  out["triggers_late"] = s.triggers_late;
+  out["missed"] = s.missed;
+  out["too_fast"] = s.too_fast;
+  out["stale_plans_dropped"] = s.stale_plans_dropped;
+  return Json{{"summary", out}};
+}
+
+// Live: the receiver on a serial device; triggers fire on a steady_timer until SIGINT/SIGTERM.
+int runLive(const TriggersArgs& args, const gps::LocationMap& map) {
+  boost::asio::io_context io;
+  gps::LiveTriggerOptions options;
+  options.planner = args.replay.planner;
+  options.latency_s = args.replay.latency_s;
+  gps::LiveTriggerChain chain(
+      io, map, options,
+      [](const core::TriggerEvent& event, core::SteadyTime) {
+        Json line = triggerJson(event);
+        line["host_time"] = core::formatIso8601(
+            std::chrono::time_point_cast<core::Nanoseconds>(std::chrono::system_clock::now()), 6);
+        std::cout << line.dump() << std::endl;
+      },
+      printAlarm);
+  gps::SerialOptions serial;
+  serial.device = args.nmea_path;
+  serial.baud = args.baud;
+  std::unique_ptr<gps::SerialNmeaSource> source;
+  try {
+    source = std::make_unique<gps::SerialNmeaSource>(
+        io, serial,
+        [&chain](const gps::Sentence& sentence, const core::ReceptionStamp& received) {
+          chain.onSentence(sentence, received);
+        },
+        [](const gps::SerialStatus& status) {
+          Json line;
+          line["serial"] = status.event == gps::SerialEvent::kOpened ? "opened"
+                           : status.event == gps::SerialEvent::kLost ? "lost"
+                                                                     : "open_failed";
+          line["device"] = status.device;
+          line["message"] = status.message;
+          std::cerr << line.dump() << std::endl;
+        });
+  } catch (const std::invalid_argument& error) {
+    std::cerr << "fieldrig triggers: " << error.what() << '\n';
+    return kExitBadInput;
+  }
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](const boost::system::error_code&, int) {
+    source->stop();
+    chain.stop();
+  });
+  source->start();
+  io.run();
+  std::cerr << summaryJson(map, source->stats(), chain.planner().stats()).dump() << std::endl;
+  return kExitOk;
 }
 
 int runTriggers(const TriggersArgs& args) {
@@ -34,6 +130,8 @@ int runTriggers(const TriggersArgs& args) {
     std::cerr << "fieldrig triggers: " << args.map_path << ": the map has no locations\n";
     return kExitBadInput;
   }
+  if (std::filesystem::is_character_file(args.nmea_path))
+    return runLive(args, *map);
   std::ifstream nmea(args.nmea_path, std::ios::binary);
   if (!nmea) {
     std::cerr << "fieldrig triggers: cannot open NMEA file '" << args.nmea_path << "'\n";
@@ -41,45 +139,13 @@ int runTriggers(const TriggersArgs& args) {
   }
 
   gps::ReplayHandlers handlers;
-  handlers.on_trigger = [&](const core::TriggerEvent& event) {
-    Json line;
-    line["trigger_id"] = event.trigger_id;
-    line["location"] = event.location_id;
-    line["time"] = core::formatIso8601(event.time, 6);
-    line["status"] = core::toString(event.status);
-    line["predicted_crossing"] = core::formatIso8601(event.planned_time, 6);
-    line["last_fix_time"] = core::formatIso8601(event.last_fix_time, 6);
-    line["speed_mps"] = event.speed_mps;
-    line["course_deg"] = event.course_deg;
-    line["cross_track_m"] = event.cross_track_m;
-    std::cout << line.dump() << '\n';
+  handlers.on_trigger = [](const core::TriggerEvent& event) {
+    std::cout << triggerJson(event).dump() << '\n';
   };
-  handlers.on_alarm = [](const gps::PlannerAlarm& alarm) {
-    Json line;
-    line["alarm"] = alarmName(alarm.kind);
-    line["location"] = alarm.location_id;
-    line["time"] = core::formatIso8601(alarm.time, 6);
-    line["message"] = alarm.message;
-    std::cerr << line.dump() << '\n';
-  };
+  handlers.on_alarm = printAlarm;
   const gps::ReplaySummary summary = gps::replayTriggers(nmea, *map, args.replay, handlers);
   std::cout.flush();
-
-  const gps::TriggerStats& s = summary.planner;
-  Json out;
-  out["locations"] = map->size();
-  out["sentences"] = summary.nmea.sentences;
-  out["rejected_lines"] = summary.nmea.rejectedTotal();
-  out["fixes"] = s.fixes;
-  out["fixes_invalid"] = s.fixes_invalid;
-  out["fixes_too_slow"] = s.fixes_too_slow;
-  out["track_restarts"] = s.track_restarts;
-  out["triggers"] = s.triggers;
-  out["triggers_late"] = s.triggers_late;
-  out["missed"] = s.missed;
-  out["too_fast"] = s.too_fast;
-  out["stale_plans_dropped"] = s.stale_plans_dropped;
-  std::cerr << Json{{"summary", out}}.dump() << '\n';
+  std::cerr << summaryJson(*map, summary.nmea, summary.planner).dump() << '\n';
   return kExitOk;
 }
 
@@ -91,7 +157,10 @@ void registerTriggersCommand(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "triggers", "Replay an NMEA capture against an imaging-location map and print the triggers");
   cmd->add_option("--map", args->map_path, "imaging-location map (CSV)")->required();
-  cmd->add_option("--nmea", args->nmea_path, "NMEA capture to replay in GPS time")->required();
+  cmd->add_option("--nmea", args->nmea_path,
+                  "NMEA capture to replay in GPS time, or a serial device to run live")
+      ->required();
+  cmd->add_option("--baud", args->baud, "serial baud rate (live)")->capture_default_str();
   cmd->add_option("--latency", args->replay.latency_s, "receiver and serial latency, seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
