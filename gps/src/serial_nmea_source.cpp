@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <boost/asio/post.hpp>
 
 #include <algorithm>
 #include <stdexcept>
@@ -18,7 +19,8 @@ constexpr std::array<unsigned, 6> kStandardBaudRates{4800, 9600, 19200, 38400, 5
 constexpr std::chrono::seconds kRepeatLogInterval{10};
 
 std::string suppressedNote(std::uint64_t suppressed) {
-  return suppressed == 0 ? std::string{} : fmt::format(" ({} similar lines suppressed)", suppressed);
+  return suppressed == 0 ? std::string{}
+                         : fmt::format(" ({} similar lines suppressed)", suppressed);
 }
 
 }  // namespace
@@ -46,7 +48,8 @@ SerialNmeaSource::SerialNmeaSource(boost::asio::io_context& io, SerialOptions op
       next_delay_(options_.reopen_initial_delay),
       parser_([this](const Sentence& sentence) {
         // stop() from inside a callback ends the callbacks even within the chunk being parsed.
-        if (running_ && on_sentence_) on_sentence_(sentence, chunk_received_);
+        if (running_ && on_sentence_)
+          on_sentence_(sentence, chunk_received_);
       }) {
   if (std::find(kStandardBaudRates.begin(), kStandardBaudRates.end(), options_.baud) ==
       kStandardBaudRates.end()) {
@@ -55,25 +58,29 @@ SerialNmeaSource::SerialNmeaSource(boost::asio::io_context& io, SerialOptions op
                     "57600 or 115200)",
                     options_.device, options_.baud));
   }
-  if (options_.device.empty()) throw std::invalid_argument("serial port: empty device path");
+  if (options_.device.empty())
+    throw std::invalid_argument("serial port: empty device path");
   if (options_.reopen_initial_delay.count() <= 0 ||
       options_.reopen_max_delay < options_.reopen_initial_delay) {
-    throw std::invalid_argument(
-        fmt::format("serial port {}: reopen delays must satisfy 0 < initial ({} ms) <= max ({} ms)",
-                    options_.device, options_.reopen_initial_delay.count(),
-                    options_.reopen_max_delay.count()));
+    throw std::invalid_argument(fmt::format(
+        "serial port {}: reopen delays must satisfy 0 < initial ({} ms) <= max ({} ms)",
+        options_.device, options_.reopen_initial_delay.count(), options_.reopen_max_delay.count()));
   }
 }
 
-SerialNmeaSource::~SerialNmeaSource() { stop(); }
+SerialNmeaSource::~SerialNmeaSource() {
+  stop();
+}
 
 void SerialNmeaSource::start() {
-  if (running_) return;
+  if (running_)
+    return;
   running_ = true;
   next_delay_ = options_.reopen_initial_delay;
   const std::uint64_t epoch = epoch_;
   boost::asio::post(io_, [this, alive = std::weak_ptr<char>(alive_), epoch] {
-    if (alive.expired() || epoch != epoch_ || !running_) return;
+    if (alive.expired() || epoch != epoch_ || !running_)
+      return;
     tryOpen();
   });
 }
@@ -95,9 +102,12 @@ void SerialNmeaSource::closePort() {
 void SerialNmeaSource::configurePort(boost::system::error_code& error) {
   using boost::asio::serial_port_base;
   port_.set_option(serial_port_base::baud_rate(options_.baud), error);
-  if (!error) port_.set_option(serial_port_base::character_size(8), error);
-  if (!error) port_.set_option(serial_port_base::parity(serial_port_base::parity::none), error);
-  if (!error) port_.set_option(serial_port_base::stop_bits(serial_port_base::stop_bits::one), error);
+  if (!error)
+    port_.set_option(serial_port_base::character_size(8), error);
+  if (!error)
+    port_.set_option(serial_port_base::parity(serial_port_base::parity::none), error);
+  if (!error)
+    port_.set_option(serial_port_base::stop_bits(serial_port_base::stop_bits::one), error);
   if (!error) {
     port_.set_option(serial_port_base::flow_control(serial_port_base::flow_control::none), error);
   }
@@ -106,7 +116,8 @@ void SerialNmeaSource::configurePort(boost::system::error_code& error) {
 void SerialNmeaSource::tryOpen() {
   boost::system::error_code error;
   port_.open(options_.device, error);
-  if (!error) configurePort(error);
+  if (!error)
+    configurePort(error);
   if (error) {
     closePort();
     ++open_failures_;
@@ -118,7 +129,8 @@ void SerialNmeaSource::tryOpen() {
   // Normally empty: a line left by stop() in the middle of it is reported now as the truncated
   // line it is, so that it cannot be completed by the first bytes of the new connection.
   parser_.flush();
-  if (epoch != epoch_ || !running_) return;
+  if (epoch != epoch_ || !running_)
+    return;
 
   std::uint64_t suppressed = 0;
   if (shouldLog(SerialEvent::kOpened, suppressed)) {
@@ -126,7 +138,8 @@ void SerialNmeaSource::tryOpen() {
                  suppressedNote(suppressed));
   }
   report({SerialEvent::kOpened, options_.device, {}, std::chrono::milliseconds{0}});
-  if (epoch != epoch_ || !running_) return;
+  if (epoch != epoch_ || !running_)
+    return;
   readSome();
 }
 
@@ -143,23 +156,26 @@ void SerialNmeaSource::scheduleReopen(SerialEvent event, const std::string& reas
   // Armed before reporting, so that a stop() from the status callback cancels it.
   const std::uint64_t epoch = epoch_;
   reopen_timer_.expires_after(delay);
-  reopen_timer_.async_wait([this, alive = std::weak_ptr<char>(alive_),
-                            epoch](const boost::system::error_code& error) {
-    if (alive.expired() || error || epoch != epoch_ || !running_) return;
-    tryOpen();
-  });
+  reopen_timer_.async_wait(
+      [this, alive = std::weak_ptr<char>(alive_), epoch](const boost::system::error_code& error) {
+        if (alive.expired() || error || epoch != epoch_ || !running_)
+          return;
+        tryOpen();
+      });
   report({event, options_.device, reason, delay});
 }
 
 void SerialNmeaSource::readSome() {
   const std::uint64_t epoch = epoch_;
-  port_.async_read_some(
-      boost::asio::buffer(buffer_), [this, alive = std::weak_ptr<char>(alive_), epoch](
-                                        const boost::system::error_code& error, std::size_t bytes) {
-        // Aborted reads of a port closed on purpose (loss handled, stop) belong to an old epoch.
-        if (alive.expired() || epoch != epoch_ || !running_) return;
-        handleRead(error, bytes);
-      });
+  port_.async_read_some(boost::asio::buffer(buffer_),
+                        [this, alive = std::weak_ptr<char>(alive_), epoch](
+                            const boost::system::error_code& error, std::size_t bytes) {
+                          // Aborted reads of a port closed on purpose (loss handled, stop) belong
+                          // to an old epoch.
+                          if (alive.expired() || epoch != epoch_ || !running_)
+                            return;
+                          handleRead(error, bytes);
+                        });
 }
 
 void SerialNmeaSource::handleRead(const boost::system::error_code& error, std::size_t bytes) {
@@ -177,7 +193,8 @@ void SerialNmeaSource::handleRead(const boost::system::error_code& error, std::s
   }
   const std::uint64_t epoch = epoch_;
   parser_.feed(std::string_view(buffer_.data(), bytes));
-  if (epoch != epoch_ || !running_) return;
+  if (epoch != epoch_ || !running_)
+    return;
   readSome();
 }
 
@@ -188,12 +205,14 @@ void SerialNmeaSource::handleLoss(const boost::system::error_code& error) {
   // The partial line the device was sending when it vanished is reported as rejected now: the
   // first bytes after a reopen start mid-stream and must not complete it.
   parser_.flush();
-  if (epoch != epoch_ || !running_) return;
+  if (epoch != epoch_ || !running_)
+    return;
   scheduleReopen(SerialEvent::kLost, error.message());
 }
 
 void SerialNmeaSource::report(const SerialStatus& status) {
-  if (on_status_) on_status_(status);
+  if (on_status_)
+    on_status_(status);
 }
 
 bool SerialNmeaSource::shouldLog(SerialEvent event, std::uint64_t& suppressed) {

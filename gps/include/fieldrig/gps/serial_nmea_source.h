@@ -17,6 +17,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "fieldrig/core/time.h"
 #include "fieldrig/gps/nmea_parser.h"
@@ -24,8 +25,8 @@
 namespace fieldrig::gps {
 
 struct SerialOptions {
-  std::string device;               // e.g. /dev/ttyUSB0
-  unsigned baud = 115200;           // 4800, 9600, 19200, 38400, 57600 or 115200; always 8N1
+  std::string device;      // e.g. /dev/ttyUSB0
+  unsigned baud = 115200;  // 4800, 9600, 19200, 38400, 57600 or 115200; always 8N1
   std::chrono::milliseconds reopen_initial_delay{100};
   std::chrono::milliseconds reopen_max_delay{5000};
 };
@@ -36,7 +37,7 @@ std::string_view toString(SerialEvent event);
 struct SerialStatus {
   SerialEvent event = SerialEvent::kOpened;
   std::string device;
-  std::string message;              // the system's error text for kLost / kOpenFailed
+  std::string message;                    // the system's error text for kLost / kOpenFailed
   std::chrono::milliseconds retry_in{0};  // kLost / kOpenFailed: when the next open is tried
 };
 
