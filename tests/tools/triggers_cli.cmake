@@ -3,5 +3,4 @@ fieldrig_add_test(triggers_cli_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/triggers_cli_test.cpp
   LIBS fieldrig::sim nlohmann_json::nlohmann_json
   LABELS tools)
-target_include_directories(triggers_cli_test PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 add_dependencies(triggers_cli_test fieldrig)
