@@ -1,0 +1,99 @@
+// `fieldrig triggers --nmea DEVICE` live: a simulated drive is written into a real pty (socat)
+// at the pace of its GPS times; the CLI reads the other end as it would /dev/ttyUSB0 and must
+// fire every location once, on time, until SIGINT.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "fieldrig/gps/field_plan.h"
+#include "fieldrig/sim/drive_simulator.h"
+#include "fieldrig/sim/trigger_accuracy.h"
+#include "support/cli_run.h"
+#include "support/socat_pty.h"
+
+namespace fieldrig {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using Json = nlohmann::json;
+
+TEST(TriggersLiveCliTest, FiresEveryLocationOnceFromASerialDevice) {
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / ("triggers_live_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  gps::FieldPlan plan;
+  plan.row_start_latitude_deg = 41.99;
+  plan.row_start_longitude_deg = -93.64;
+  plan.row_end_latitude_deg = 41.99 + 10.0 / 111'000.0;
+  plan.row_end_longitude_deg = -93.64;
+  plan.rows = 2;
+  plan.plot_length_m = 2.0;
+  plan.alley_length_m = 1.0;
+  const auto map = gps::generateLocations(plan);
+  ASSERT_TRUE(map.ok()) << map.error().message;
+  ASSERT_TRUE(map->save(dir / "map.csv").ok());
+  sim::DriveOptions options;
+  options.speed_mps = 3.0;
+  options.headland_m = 2.0;
+  const sim::DriveSimulator drive(plan, options);
+
+  testing_support::SocatPty pty(dir);
+  const std::string started = pty.start();
+  ASSERT_EQ(started, "") << started;
+
+  const fs::path out = dir / "triggers.jsonl";
+  const fs::path err = dir / "triggers.err";
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    const int out_fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out_fd, STDOUT_FILENO);
+    ::dup2(err_fd, STDERR_FILENO);
+    const std::string map_path = (dir / "map.csv").string();
+    const std::string device = pty.device().string();
+    ::execl(testing_support::kFieldrigBinary.c_str(), "fieldrig", "triggers", "--map",
+            map_path.c_str(), "--nmea", device.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ASSERT_GT(child, 0);
+  std::this_thread::sleep_for(300ms);  // let it open the device
+
+  // Write each epoch's sentences at its GPS time (relative to the drive's start).
+  testing_support::Feed feed(pty.feed());
+  ASSERT_TRUE(feed.ok());
+  const auto lines = testing_support::splitLines(drive.nmea());
+  const auto origin = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < lines.size(); i += 2) {
+    const std::string epoch = lines[i] + "\n" + lines[i + 1] + "\n";
+    std::this_thread::sleep_until(origin + std::chrono::milliseconds(50 * i));  // 10 Hz: 2 lines
+    ASSERT_TRUE(feed.write(epoch));
+  }
+  std::this_thread::sleep_for(300ms);
+  ::kill(child, SIGINT);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << testing_support::readWholeFile(err);
+  EXPECT_EQ(WEXITSTATUS(status), 0) << testing_support::readWholeFile(err);
+
+  std::vector<core::TriggerEvent> events;
+  for (const std::string& text : testing_support::splitLines(testing_support::readWholeFile(out))) {
+    const Json line = Json::parse(text);
+    core::TriggerEvent event;
+    event.location_id = line["location"];
+    event.time = *core::parseIso8601(line["time"].get<std::string>());
+    events.push_back(event);
+    EXPECT_TRUE(line.contains("host_time"));
+  }
+  const sim::TriggerAccuracy accuracy = sim::scoreTriggers(drive, *map, events);
+  EXPECT_EQ(accuracy.fired_once, map->size()) << testing_support::readWholeFile(err);
+  // The planned GPS times are as accurate as in replay; the host clock only decides when.
+  EXPECT_LT(accuracy.max_abs_m, 0.04);
+  const std::string log = testing_support::readWholeFile(err);
+  EXPECT_NE(log.find("\"summary\""), std::string::npos) << log;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace fieldrig
