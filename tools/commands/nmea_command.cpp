@@ -1,4 +1,5 @@
 // `fieldrig nmea decode FILE`: one JSON object per intact RMC/GGA sentence, then a summary.
+#include <array>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -55,13 +56,18 @@ int runDecode(const std::string& path) {
     std::cerr << "fieldrig nmea decode: cannot open '" << path << "'\n";
     return kExitBadInput;
   }
-  gps::NmeaParser parser([](const gps::Sentence& s) {
-    if (s.kind == gps::SentenceKind::kRmc) {
-      std::cout << rmcJson(s).dump() << '\n';
-    } else if (s.kind == gps::SentenceKind::kGga) {
-      std::cout << ggaJson(s).dump() << '\n';
-    }
-  });
+  // A file is a capture: its '#' header lines (gpsd logs, recordings) are comments, not noise.
+  gps::NmeaParserOptions options;
+  options.comment_lines = true;
+  gps::NmeaParser parser(
+      [](const gps::Sentence& s) {
+        if (s.kind == gps::SentenceKind::kRmc) {
+          std::cout << rmcJson(s).dump() << '\n';
+        } else if (s.kind == gps::SentenceKind::kGga) {
+          std::cout << ggaJson(s).dump() << '\n';
+        }
+      },
+      options);
   std::array<char, 65536> chunk{};
   while (in.read(chunk.data(), chunk.size()) || in.gcount() > 0) {
     parser.feed(std::string_view(chunk.data(), static_cast<std::size_t>(in.gcount())));
@@ -76,6 +82,7 @@ int runDecode(const std::string& path) {
   Json summary;
   summary["file"] = path;
   summary["lines"] = stats.lines;
+  summary["comments"] = stats.comments;
   summary["sentences"] = stats.sentences;
   summary["rmc"] = stats.rmc;
   summary["gga"] = stats.gga;
