@@ -434,4 +434,23 @@ void NmeaParser::flush() {
   discarding_ = false;
 }
 
+unsigned char nmeaChecksum(std::string_view body) {
+  unsigned char checksum = 0;
+  for (char c : body) checksum ^= static_cast<unsigned char>(c);
+  return checksum;
+}
+
+std::string withChecksum(std::string_view body) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  const unsigned char checksum = nmeaChecksum(body);
+  std::string sentence;
+  sentence.reserve(body.size() + 4);
+  sentence += '$';
+  sentence += body;
+  sentence += '*';
+  sentence += kHex[checksum >> 4];
+  sentence += kHex[checksum & 0x0f];
+  return sentence;
+}
+
 }  // namespace fieldrig::gps

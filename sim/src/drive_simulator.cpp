@@ -7,6 +7,8 @@
 #include <random>
 #include <stdexcept>
 
+#include "fieldrig/gps/nmea_parser.h"
+
 namespace fieldrig::sim {
 namespace {
 
@@ -55,15 +57,6 @@ gps::EnuPoint add(const gps::EnuPoint& p, double e, double n) {
 }
 
 }  // namespace
-
-std::string withChecksum(const std::string& body) {
-  unsigned char checksum = 0;
-  for (char c : body)
-    checksum ^= static_cast<unsigned char>(c);
-  char suffix[4];
-  std::snprintf(suffix, sizeof suffix, "*%02X", checksum);
-  return "$" + body + suffix;
-}
 
 DriveSimulator::DriveSimulator(const gps::FieldPlan& plan, DriveOptions options)
     : options_(std::move(options)),
@@ -171,10 +164,10 @@ std::string DriveSimulator::nmea() const {
     std::snprintf(numbers, sizeof numbers, "%.3f,%.2f",
                   options_.speed_mps * kKnotsPerMetrePerSecond,
                   gps::bearingDegrees(pose.unit_east, pose.unit_north));
-    out += withChecksum(options_.talker + "RMC," + timeText(t) + ",A," + lat + "," + lon + "," +
+    out += gps::withChecksum(options_.talker + "RMC," + timeText(t) + ",A," + lat + "," + lon + "," +
                         numbers + "," + dateText(t) + ",,,R") +
            "\r\n";
-    out += withChecksum(options_.talker + "GGA," + timeText(t) + "," + lat + "," + lon +
+    out += gps::withChecksum(options_.talker + "GGA," + timeText(t) + "," + lat + "," + lon +
                         ",4,14,0.7,285.000,M,-33.000,M,1.0,0001") +
            "\r\n";
   }

@@ -101,11 +101,5 @@ TEST(DriveSimulatorTest, NoiseHasTheRequestedSpread) {
   EXPECT_NEAR(per_axis_sd, 0.01, 0.001);
 }
 
-TEST(DriveSimulatorTest, ChecksumMatchesTheNmeaDefinition) {
-  // XOR of "GPGLL,5057.970,N,00146.110,E,142451,A" is 0x27 (computed independently of this code).
-  EXPECT_EQ(withChecksum("GPGLL,5057.970,N,00146.110,E,142451,A"),
-            "$GPGLL,5057.970,N,00146.110,E,142451,A*27");
-}
-
 }  // namespace
 }  // namespace fieldrig::sim

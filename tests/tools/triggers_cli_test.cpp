@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fieldrig/gps/field_plan.h"
+#include "fieldrig/gps/nmea_parser.h"
 #include "fieldrig/sim/drive_simulator.h"
 #include "fieldrig/sim/trigger_accuracy.h"
 #include "support/cli_run.h"
@@ -101,7 +102,7 @@ TEST_F(TriggersCliTest, InvalidFixesYieldNoTriggers) {
     } else {
       body.replace(body.find(",4,14,"), 6, ",0,14,");
     }
-    nmea += sim::withChecksum(body) + "\r\n";
+    nmea += gps::withChecksum(body) + "\r\n";
   }
   write(dir_ / "nofix.nmea", nmea);
   const auto run = runFieldrig(

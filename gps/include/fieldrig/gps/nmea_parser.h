@@ -130,4 +130,11 @@ class NmeaParser {
   NmeaStats stats_;
 };
 
+// The XOR checksum NMEA 0183 puts after '*': over the bytes between '$' and '*'.
+unsigned char nmeaChecksum(std::string_view body);
+
+// "$<body>*HH": a complete sentence (without CR/LF) for a body such as "GPRMC,…", for the
+// simulator and tools that write NMEA.
+std::string withChecksum(std::string_view body);
+
 }  // namespace fieldrig::gps

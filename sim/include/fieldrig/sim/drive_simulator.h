@@ -74,7 +74,4 @@ class DriveSimulator {
   double length_m_ = 0;
 };
 
-// "$<body>*HH" with the NMEA checksum; exposed for tests that write their own sentences.
-std::string withChecksum(const std::string& body);
-
 }  // namespace fieldrig::sim
