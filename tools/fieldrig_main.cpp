@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   fieldrig::tools::registerNmeaCommand(app, exit_code);
   fieldrig::tools::registerMapCommand(app, exit_code);
   fieldrig::tools::registerTriggersCommand(app, exit_code);
+  fieldrig::tools::registerSimCommand(app, exit_code);
   CLI11_PARSE(app, argc, argv);
   return exit_code;
 }

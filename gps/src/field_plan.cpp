@@ -123,8 +123,14 @@ core::Result<LocationMap> generateLocations(const FieldPlan& plan) {
     }
   }
 
-  const double forward_heading = bearingDegrees(along_east, along_north);
-  const double backward_heading = std::fmod(forward_heading + 180.0, 360.0);
+  // Headings to a micro-degree: finer is noise of the tangent-plane arithmetic (a due-north row
+  // would otherwise read 359.99999999999494) and means nothing to the ±60° travel test.
+  const auto tidy = [](double degrees) {
+    const double rounded = std::round(degrees * 1e6) / 1e6;
+    return rounded >= 360.0 ? rounded - 360.0 : rounded;
+  };
+  const double forward_heading = tidy(bearingDegrees(along_east, along_north));
+  const double backward_heading = tidy(std::fmod(forward_heading + 180.0, 360.0));
   // Ids are zero-padded to the widest number (at least two digits) so that they sort in field
   // order as text.
   const int row_width = std::max(2, decimalDigits(plan.rows));

@@ -8,11 +8,12 @@ namespace fieldrig::tools {
 
 // Exit codes shared by all subcommands.
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitBadInput = 2;    // a file or option that cannot be used
-inline constexpr int kExitRuntime = 3;     // a failure while running (device lost for good…)
+inline constexpr int kExitBadInput = 2;  // a file or option that cannot be used
+inline constexpr int kExitRuntime = 3;   // a failure while running (device lost for good…)
 
 void registerNmeaCommand(CLI::App& app, int& exit_code);
 void registerMapCommand(CLI::App& app, int& exit_code);
 void registerTriggersCommand(CLI::App& app, int& exit_code);
+void registerSimCommand(CLI::App& app, int& exit_code);
 
 }  // namespace fieldrig::tools

@@ -38,6 +38,7 @@
 #include <utility>
 
 #include "commands/commands.h"
+#include "commands/field_plan_options.h"
 #include "fieldrig/core/time.h"
 #include "fieldrig/gps/field_plan.h"
 #include "fieldrig/gps/fix_assembler.h"
@@ -56,48 +57,17 @@ namespace asio = boost::asio;
 // map generate
 
 struct GenerateOptions {
-  std::string row_start;
-  std::string row_end;
-  gps::FieldPlan plan;
-  bool left = false;
+  FieldPlanArgs field;
   std::string out;
 };
 
-bool parseDouble(std::string_view text, double& out) {
-  while (!text.empty() && text.front() == ' ')
-    text.remove_prefix(1);
-  while (!text.empty() && text.back() == ' ')
-    text.remove_suffix(1);
-  if (!text.empty() && text.front() == '+')
-    text.remove_prefix(1);
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
-  return !text.empty() && ec == std::errc() && ptr == text.data() + text.size() &&
-         std::isfinite(out);
-}
-
-// "LAT,LON" in decimal degrees.
-bool parseLatLon(std::string_view text, double& latitude, double& longitude) {
-  const std::size_t comma = text.find(',');
-  if (comma == std::string_view::npos)
-    return false;
-  return parseDouble(text.substr(0, comma), latitude) &&
-         parseDouble(text.substr(comma + 1), longitude);
-}
-
-int runGenerate(GenerateOptions options) {
-  gps::FieldPlan& plan = options.plan;
-  if (!parseLatLon(options.row_start, plan.row_start_latitude_deg, plan.row_start_longitude_deg)) {
-    std::cerr << "fieldrig map generate: --row-start: '" << options.row_start
-              << "' is not LAT,LON in decimal degrees\n";
+int runGenerate(const GenerateOptions& options) {
+  const auto plan = resolveFieldPlan(options.field);
+  if (!plan) {
+    std::cerr << "fieldrig map generate: " << plan.error().message << '\n';
     return kExitBadInput;
   }
-  if (!parseLatLon(options.row_end, plan.row_end_latitude_deg, plan.row_end_longitude_deg)) {
-    std::cerr << "fieldrig map generate: --row-end: '" << options.row_end
-              << "' is not LAT,LON in decimal degrees\n";
-    return kExitBadInput;
-  }
-  plan.rows_to_the_right = !options.left;
-  auto map = gps::generateLocations(plan);
+  auto map = gps::generateLocations(*plan);
   if (!map) {
     std::cerr << "fieldrig map generate: " << map.error().message << '\n';
     return kExitBadInput;
@@ -110,8 +80,8 @@ int runGenerate(GenerateOptions options) {
   Json summary;
   summary["out"] = options.out;
   summary["locations"] = map->size();
-  summary["rows"] = plan.rows;
-  summary["plots_per_row"] = map->size() / static_cast<std::size_t>(plan.rows);
+  summary["rows"] = plan->rows;
+  summary["plots_per_row"] = map->size() / static_cast<std::size_t>(plan->rows);
   std::cout << summary.dump() << '\n';
   return kExitOk;
 }
@@ -667,21 +637,7 @@ void registerMapCommand(CLI::App& app, int& exit_code) {
   CLI::App* generate =
       map->add_subcommand("generate", "Write a map of plot centres from a field plan");
   auto g = std::make_shared<GenerateOptions>();
-  generate->add_option("--row-start", g->row_start, "Start of the first row: LAT,LON")->required();
-  generate->add_option("--row-end", g->row_end, "End of the first row: LAT,LON")->required();
-  generate->add_option("--rows", g->plan.rows, "Number of rows")->required();
-  generate->add_option("--plots", g->plan.plots_per_row, "Plots per row (0: as many as fit)")
-      ->capture_default_str();
-  generate->add_option("--plot-length", g->plan.plot_length_m, "Plot length, m")->required();
-  generate->add_option("--alley-length", g->plan.alley_length_m, "Alley length, m")->required();
-  generate->add_option("--row-spacing", g->plan.row_spacing_m, "Row spacing, m")->required();
-  generate
-      ->add_option("--start-offset", g->plan.start_offset_m,
-                   "Distance from the row start to the first plot, m")
-      ->capture_default_str();
-  generate->add_flag("--left", g->left,
-                     "Further rows lie to the left of the first (default right)");
-  generate->add_option("--id-prefix", g->plan.id_prefix, "Prefix of the ids <prefix>R<row>P<plot>");
+  addFieldPlanOptions(*generate, g->field);
   generate->add_option("--out", g->out, "Map file to write")->required();
   generate->callback([g, &exit_code] { exit_code = runGenerate(*g); });
 
