@@ -23,6 +23,8 @@ using LocationIndex = bgi::rtree<IndexEntry, bgi::rstar<16>>;
 constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
 // A fit needs this many fixes; three is the fewest that still averages some noise.
 constexpr std::size_t kMinFitSamples = 3;
+// How far back along the track a location passed without a plan is still reported missed.
+constexpr double kMaxMissedSearchM = 30.0;
 constexpr core::Nanoseconds kDecisionTime = std::chrono::microseconds{1};
 
 struct Target {
@@ -126,7 +128,8 @@ struct TriggerPlanner::State {
   std::optional<core::UtcTime> last_fix_time;
   std::deque<Sample> samples;
   std::optional<Track> track;
-  std::vector<Plan> plans;  // sorted by time
+  std::optional<EnuPoint> last_planned_position;  // the track's position at the last plan
+  std::vector<Plan> plans;                        // sorted by time
   std::optional<core::UtcTime> last_trigger_time;
   std::uint64_t next_trigger_id = 1;
   TriggerStats stats;
@@ -185,13 +188,13 @@ struct TriggerPlanner::State {
     }
   }
 
-  void plan(core::UtcTime now, double travelled_since_previous) {
+  void plan(core::UtcTime now, double unplanned_distance) {
     plans.clear();
     const Track& tr = *track;
     const double right_east = tr.unit_north;  // clockwise normal of the direction of travel
     const double right_north = -tr.unit_east;
     const double tolerance = options.cross_track_tolerance_m;
-    const double behind = options.late_tolerance_m + travelled_since_previous + tolerance;
+    const double behind = options.late_tolerance_m + unplanned_distance + tolerance;
     const double ahead = tr.speed * (options.max_fix_gap_s + options.trigger_lead_s) + tolerance;
     const double cos_heading_tolerance =
         std::cos(options.heading_tolerance_deg / kDegreesPerRadian);
@@ -225,7 +228,7 @@ struct TriggerPlanner::State {
         continue;
       if (along < -options.late_tolerance_m) {
         if (along >= -behind) {
-          // Passed since the previous fix without a plan (no track then): report, don't fire.
+          // Passed since the last plan (no usable track then): report it, never fire it.
           ++stats.missed;
           alarms.push_back({AlarmKind::kMissed, map.locations()[i].id, fix_time,
                             "location passed without a trigger (no usable track in time)"});
@@ -299,14 +302,9 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
     return;
   }
   const double t = s.seconds(fix.time);
-  double travelled_since_previous = 0;
   if (!s.samples.empty() && t - s.samples.back().t > s.options.max_fix_gap_s)
     s.restartTrack();
   const EnuPoint position = s.frame.toLocal(fix.latitude_deg, fix.longitude_deg);
-  if (!s.samples.empty()) {
-    travelled_since_previous = std::hypot(position.east_m - s.samples.back().east,
-                                          position.north_m - s.samples.back().north);
-  }
   s.samples.push_back({t, position.east_m, position.north_m});
   while (s.samples.size() > kMinFitSamples &&
          t - s.samples.front().t > s.options.fit_window_s + 1e-6) {
@@ -323,7 +321,17 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
     s.plans.clear();
     return;
   }
-  s.plan(now, travelled_since_previous);
+  // Distance covered since the last plan: locations passed on it (during invalid fixes, a gap,
+  // a turn without a usable track) are reported missed. Capped so that re-entering the field far
+  // away does not blame plots that were never on this pass.
+  double unplanned_distance = 0;
+  if (s.last_planned_position) {
+    unplanned_distance =
+        std::min(kMaxMissedSearchM, std::hypot(s.track->east - s.last_planned_position->east_m,
+                                               s.track->north - s.last_planned_position->north_m));
+  }
+  s.plan(now, unplanned_distance);
+  s.last_planned_position = EnuPoint{s.track->east, s.track->north};
 }
 
 std::optional<core::UtcTime> TriggerPlanner::nextTriggerTime() const {

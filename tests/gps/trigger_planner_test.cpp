@@ -157,6 +157,24 @@ TEST(TriggerPlannerTest, InvalidFixJustBeforeTheLocationDropsThePlan) {
   EXPECT_TRUE(events.empty());
 }
 
+TEST(TriggerPlannerTest, LocationPassedDuringInvalidFixesIsReportedMissed) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);   // crossed at k = 75, while the fix is invalid
+  field.addLocation("B", 0.0, 12.0);  // crossed at k = 110, valid again
+  TriggerPlanner planner(field.map(), {});
+  Drive d;
+  d.duration_s = 13;
+  d.valid = [](int k) { return k < 70 || k > 85; };
+  const auto events = drive(field, planner, d);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].location_id, "B");
+  EXPECT_EQ(planner.stats().missed, 1u);
+  const auto alarms = planner.takeAlarms();
+  ASSERT_EQ(alarms.size(), 1u);
+  EXPECT_EQ(alarms[0].kind, AlarmKind::kMissed);
+  EXPECT_EQ(alarms[0].location_id, "A");
+}
+
 TEST(TriggerPlannerTest, StoppedOrCreepingNeverTriggers) {
   Field field;
   field.addLocation("A", 0.0, 0.05);
