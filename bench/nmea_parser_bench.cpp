@@ -13,15 +13,6 @@
 
 namespace {
 
-std::string withChecksum(const std::string& body) {
-  unsigned char sum = 0;
-  for (char c : body)
-    sum ^= static_cast<unsigned char>(c);
-  char tail[8];
-  std::snprintf(tail, sizeof tail, "*%02X\r\n", sum);
-  return "$" + body + tail;
-}
-
 // Minutes with 8 decimals, as Trimble/CAT machine receivers send them.
 std::string coordinate(double degrees, int degree_digits) {
   const double magnitude = std::fabs(degrees);
@@ -49,10 +40,10 @@ std::string rtkStream(int epochs) {
     char body[160];
     std::snprintf(body, sizeof body, "GNRMC,%s,A,%s,N,%s,W,3.889,9.5,140726,,,R", time,
                   lat_text.c_str(), lon_text.c_str());
-    out += withChecksum(body);
+    out += fieldrig::gps::withChecksum(body) + "\r\n";
     std::snprintf(body, sizeof body, "GNGGA,%s,%s,N,%s,W,4,17,0.7,%.3f,M,-33.4,M,1.0,0000", time,
                   lat_text.c_str(), lon_text.c_str(), 221.5 + 0.001 * (i % 50));
-    out += withChecksum(body);
+    out += fieldrig::gps::withChecksum(body) + "\r\n";
   }
   return out;
 }

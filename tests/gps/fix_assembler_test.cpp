@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,23 +16,14 @@ namespace {
 using std::chrono::sys_days;
 using namespace std::chrono_literals;
 
-std::string nmea(const std::string& body) {
-  unsigned char sum = 0;
-  for (char c : body)
-    sum ^= static_cast<unsigned char>(c);
-  char tail[4];
-  std::snprintf(tail, sizeof tail, "%02X", sum);
-  return "$" + body + "*" + tail;
-}
-
 std::string rmc(const std::string& time, const std::string& date, char status = 'A') {
-  return nmea("GNRMC," + time + "," + status + ",4004.92740741,N,08813.16074074,W,3.888,90.0," +
-              date + ",,,R");
+  return withChecksum("GNRMC," + time + "," + status +
+                      ",4004.92740741,N,08813.16074074,W,3.888,90.0," + date + ",,,R");
 }
 
 std::string gga(const std::string& time, int quality = 4) {
-  return nmea("GNGGA," + time + ",4004.92740741,N,08813.16074074,W," + std::to_string(quality) +
-              ",17,0.7,221.5,M,-33.4,M,1.0,0000");
+  return withChecksum("GNGGA," + time + ",4004.92740741,N,08813.16074074,W," +
+                      std::to_string(quality) + ",17,0.7,221.5,M,-33.4,M,1.0,0000");
 }
 
 // Feeds one sentence; the fix the assembler returned for it.
@@ -166,8 +156,8 @@ TEST(FixAssembler, GgaQualityZeroVetoesTheEpoch) {
 
 TEST(FixAssembler, IgnoresOtherSentencesAndSentencesWithoutTime) {
   FixAssembler assembler;
-  EXPECT_FALSE(add(assembler, nmea("GPGLL,2638.1727,N,08011.3892,W,030130.000,A,A")));
-  EXPECT_FALSE(add(assembler, nmea("GPGGA,,,,,,0,00,,,M,,M,,")));
+  EXPECT_FALSE(add(assembler, withChecksum("GPGLL,2638.1727,N,08011.3892,W,030130.000,A,A")));
+  EXPECT_FALSE(add(assembler, withChecksum("GPGGA,,,,,,0,00,,,M,,M,,")));
   EXPECT_FALSE(assembler.add(NmeaParser::parseLine("garbage"), core::ReceptionStamp{}));
 }
 

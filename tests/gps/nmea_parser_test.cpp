@@ -5,7 +5,8 @@
 
 #include <cctype>
 #include <chrono>
-#include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -17,20 +18,40 @@ namespace {
 using std::chrono::sys_days;
 using namespace std::chrono_literals;
 
-// A sentence with its correct checksum, from the text between '$' and '*'.
-std::string nmea(const std::string& body) {
-  unsigned char sum = 0;
-  for (char c : body)
-    sum ^= static_cast<unsigned char>(c);
-  char tail[4];
-  std::snprintf(tail, sizeof tail, "%02X", sum);
-  return "$" + body + "*" + tail;
-}
+const std::string kRmc = withChecksum(
+    "GPRMC,113938.50,A,3842.86006889,N,11705.43645510,W,0.011,46.405,231122,999.9000,E,D");
+const std::string kGga = withChecksum(
+    "GPGGA,113938.50,3842.86006889,N,11705.43645510,W,2,09,1.5,1864.182,M,-44.296,M,1.4,0000");
 
-const std::string kRmc =
-    nmea("GPRMC,113938.50,A,3842.86006889,N,11705.43645510,W,0.011,46.405,231122,999.9000,E,D");
-const std::string kGga =
-    nmea("GPGGA,113938.50,3842.86006889,N,11705.43645510,W,2,09,1.5,1864.182,M,-44.296,M,1.4,0000");
+// The one independent check of the checksum writer every test here builds its sentences with:
+// sentences copied verbatim from a receiver's log (gpsd's regression data) must come out of
+// withChecksum identically, hex digits in upper case with a leading zero kept.
+TEST(NmeaChecksum, WithChecksumReproducesSentencesFromAReceiverLog) {
+  const std::string log_path = FIELDRIG_SHARED_DATA_DIR "/nmea/gpsd/nmea-rtk.log";
+  std::ifstream in(log_path, std::ios::binary);
+  ASSERT_TRUE(in) << "cannot open " << log_path;
+  const std::string log{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  struct Known {
+    std::string sentence;
+    unsigned char checksum;
+  };
+  const std::vector<Known> known = {
+      {"$GNRMC,132820.40,A,4134.49821522,N,09345.03375619,W,2.627,91.414,180320,11.5985,E,D*05",
+       0x05},
+      {"$GNRMC,132827.00,A,4134.49941381,N,09345.03496613,W,0.379,15.324,180320,11.5985,E,D*0A",
+       0x0A},
+      {"$GNGGA,132819.60,4134.49795459,N,09345.03431408,W,2,10,0.9,278.161,M,-31.442,M,6.6,0133*6A",
+       0x6A},
+  };
+  for (const Known& k : known) {
+    SCOPED_TRACE(k.sentence);
+    // Guards against a typo in the copy: the sentence is in the log as written here.
+    ASSERT_NE(log.find(k.sentence + "\r\n"), std::string::npos);
+    const std::string body = k.sentence.substr(1, k.sentence.size() - 4);
+    EXPECT_EQ(nmeaChecksum(body), k.checksum);
+    EXPECT_EQ(withChecksum(body), k.sentence);
+  }
+}
 
 // What one outcome looked like, copied out of the callback (views die with it).
 struct Outcome {
@@ -127,20 +148,22 @@ TEST(NmeaParser, DecodesGgaFields) {
 TEST(NmeaParser, KeepsTenDecimalsOfMinutes) {
   // 48 + 08.1234567891/60 = 48.135390946485; 011 + 35.0000000001/60 = 11.583333333335.
   const ParseRun run = parse(
-      nmea("GNGGA,000000.00,4808.1234567891,S,01135.0000000001,E,4,20,0.5,1.0,M,,M,,") + "\n");
+      withChecksum("GNGGA,000000.00,4808.1234567891,S,01135.0000000001,E,4,20,0.5,1.0,M,,M,,") +
+      "\n");
   ASSERT_EQ(run.outcomes.size(), 1u);
   EXPECT_NEAR(*run.outcomes[0].gga.latitude_deg, -48.135390946485, 2e-12);
   EXPECT_NEAR(*run.outcomes[0].gga.longitude_deg, 11.583333333335, 2e-12);
   // Distinct in the tenth decimal of minutes: 1e-10 min = 1.7e-12 deg must not be lost.
   const ParseRun next = parse(
-      nmea("GNGGA,000000.00,4808.1234567892,S,01135.0000000001,E,4,20,0.5,1.0,M,,M,,") + "\n");
+      withChecksum("GNGGA,000000.00,4808.1234567892,S,01135.0000000001,E,4,20,0.5,1.0,M,,M,,") +
+      "\n");
   EXPECT_LT(*next.outcomes[0].gga.latitude_deg, *run.outcomes[0].gga.latitude_deg);
 }
 
 TEST(NmeaParser, SouthAndWestAreNegative) {
   const ParseRun run =
-      parse(nmea("GPRMC,010203,A,1930.0000,S,02415.0000,W,10.0,0.0,010203,,") + "\n" +
-            nmea("GPRMC,010203,A,1930.0000,N,02415.0000,E,10.0,0.0,010203,,") + "\n");
+      parse(withChecksum("GPRMC,010203,A,1930.0000,S,02415.0000,W,10.0,0.0,010203,,") + "\n" +
+            withChecksum("GPRMC,010203,A,1930.0000,N,02415.0000,E,10.0,0.0,010203,,") + "\n");
   ASSERT_EQ(run.outcomes.size(), 2u);
   EXPECT_DOUBLE_EQ(*run.outcomes[0].rmc.latitude_deg, -19.5);
   EXPECT_DOUBLE_EQ(*run.outcomes[0].rmc.longitude_deg, -24.25);
@@ -151,10 +174,10 @@ TEST(NmeaParser, SouthAndWestAreNegative) {
 }
 
 TEST(NmeaParser, TwoDigitYearsSplitAt1980) {
-  const ParseRun run = parse(nmea("GPRMC,235959,A,0000.0,N,00000.0,E,,,311299,,") + "\n" +
-                             nmea("GPRMC,000000,A,0000.0,N,00000.0,E,,,010100,,") + "\n" +
-                             nmea("GPRMC,120000,A,0000.0,N,00000.0,E,,,311279,,") + "\n" +
-                             nmea("GPRMC,120000,A,0000.0,N,00000.0,E,,,010180,,") + "\n");
+  const ParseRun run = parse(withChecksum("GPRMC,235959,A,0000.0,N,00000.0,E,,,311299,,") + "\n" +
+                             withChecksum("GPRMC,000000,A,0000.0,N,00000.0,E,,,010100,,") + "\n" +
+                             withChecksum("GPRMC,120000,A,0000.0,N,00000.0,E,,,311279,,") + "\n" +
+                             withChecksum("GPRMC,120000,A,0000.0,N,00000.0,E,,,010180,,") + "\n");
   ASSERT_EQ(run.fixes().size(), 4u);
   EXPECT_EQ(*run.outcomes[0].rmc.time, sys_days{1999y / 12 / 31} + 23h + 59min + 59s);
   EXPECT_EQ(*run.outcomes[1].rmc.time, sys_days{2000y / 1 / 1});
@@ -163,9 +186,9 @@ TEST(NmeaParser, TwoDigitYearsSplitAt1980) {
 }
 
 TEST(NmeaParser, TimeOfDayFractionIsExactToTheNanosecond) {
-  const ParseRun run = parse(nmea("GNGGA,235959.123456789,,,,,0,,,,,,,,") + "\n" +
-                             nmea("GNGGA,000000.1,,,,,0,,,,,,,,") + "\n" +
-                             nmea("GNGGA,120000.0000000001,,,,,0,,,,,,,,") + "\n");
+  const ParseRun run = parse(withChecksum("GNGGA,235959.123456789,,,,,0,,,,,,,,") + "\n" +
+                             withChecksum("GNGGA,000000.1,,,,,0,,,,,,,,") + "\n" +
+                             withChecksum("GNGGA,120000.0000000001,,,,,0,,,,,,,,") + "\n");
   ASSERT_EQ(run.outcomes.size(), 3u);
   EXPECT_EQ(*run.outcomes[0].gga.time_of_day,
             23h + 59min + 59s + std::chrono::nanoseconds{123'456'789});
@@ -179,8 +202,8 @@ TEST(NmeaParser, AcceptsEveryTalker) {
   std::string bytes;
   const std::vector<std::string> talkers = {"GP", "GN", "GL", "GA", "GB", "IN", "BD", "GQ"};
   for (const std::string& talker : talkers) {
-    bytes += nmea(talker + "RMC,120000,A,4000.0,N,08000.0,W,0.0,0.0,010124,,,A") + "\r\n";
-    bytes += nmea(talker + "GGA,120000,4000.0,N,08000.0,W,1,05,1.0,10.0,M,,M,,") + "\r\n";
+    bytes += withChecksum(talker + "RMC,120000,A,4000.0,N,08000.0,W,0.0,0.0,010124,,,A") + "\r\n";
+    bytes += withChecksum(talker + "GGA,120000,4000.0,N,08000.0,W,1,05,1.0,10.0,M,,M,,") + "\r\n";
   }
   const ParseRun run = parse(bytes);
   ASSERT_EQ(run.outcomes.size(), 2 * talkers.size());
@@ -244,7 +267,7 @@ TEST(NmeaParser, TruncatedSentencesAreRejected) {
 
 TEST(NmeaParser, RunTogetherSentencesAreSplitAtTheNextStart) {
   // Triton 400 log: a GGA cut short by the next sentence on the same line.
-  const std::string gll = nmea("GPGLL,2638.1728,N,08011.3893,W,030131.000,A,A");
+  const std::string gll = withChecksum("GPGLL,2638.1728,N,08011.3893,W,030131.000,A,A");
   const ParseRun run = parse("$GPGGA,030130" + gll + "\r\n" + kRmc + kGga + "\r\n");
   ASSERT_EQ(run.outcomes.size(), 4u);
   EXPECT_EQ(run.outcomes[0].kind, SentenceKind::kRejected);
@@ -290,7 +313,7 @@ std::string messyStream() {
   s += "$GPGGA,030130" + kRmc + "\r\n";
   s += "$GPTXT," + std::string(250, 'y') + "\r\n";
   s += kGga.substr(0, 30) + "\r\n";
-  s += nmea("GPGSV,3,1,12,20,76,058,40") + kGga + "\n";
+  s += withChecksum("GPGSV,3,1,12,20,76,058,40") + kGga + "\n";
   s += "   \r\n";
   s += kRmc;  // no final terminator
   return s;
@@ -318,10 +341,10 @@ TEST(NmeaParser, EverySplitPointGivesTheSameResult) {
 TEST(NmeaParser, CountsEachRejectReason) {
   std::string bad_checksum = kRmc;
   bad_checksum.back() = bad_checksum.back() == '0' ? '1' : '0';
-  const ParseRun run =
-      parse("garbage\n" + kRmc.substr(0, kRmc.size() - 3) + "\n" + bad_checksum + "\n" + "$GPTXT," +
-            std::string(300, 'z') + "\n" + "$GPRMC,\x01" + "\n" +
-            nmea("GPRMC,113938.50,A,3842.8600,X,11705.4364,W,0,0,231122,,") + "\n" + kGga + "\n");
+  const ParseRun run = parse(
+      "garbage\n" + kRmc.substr(0, kRmc.size() - 3) + "\n" + bad_checksum + "\n" + "$GPTXT," +
+      std::string(300, 'z') + "\n" + "$GPRMC,\x01" + "\n" +
+      withChecksum("GPRMC,113938.50,A,3842.8600,X,11705.4364,W,0,0,231122,,") + "\n" + kGga + "\n");
   EXPECT_EQ(rejected(run.stats, RejectReason::kGarbage), 1u);
   EXPECT_EQ(rejected(run.stats, RejectReason::kNoChecksum), 1u);
   EXPECT_EQ(rejected(run.stats, RejectReason::kBadChecksum), 1u);
@@ -354,7 +377,7 @@ TEST(NmeaParser, MalformedFieldsWithAValidChecksumAreRejected) {
       "GPGGA,113938.50,3842.86,,11705.43,W,2,09,1.5,1864.182,M,,M,,",
   };
   for (const std::string& body : bodies) {
-    const ParseRun run = parse(nmea(body) + "\n");
+    const ParseRun run = parse(withChecksum(body) + "\n");
     ASSERT_EQ(run.outcomes.size(), 1u);
     EXPECT_EQ(run.outcomes[0].kind, SentenceKind::kRejected) << body;
     EXPECT_EQ(run.outcomes[0].reason, RejectReason::kMalformed) << body;
@@ -398,8 +421,8 @@ TEST(NmeaParser, CommentLinesAreCountedOnlyWhenAskedFor) {
 
 TEST(NmeaParser, StatusVoidIsDecodedButNotValid) {
   const ParseRun run =
-      parse(nmea("GPRMC,235948.00,V,0000.0000,N,00000.0000,E,,,161206,,,N") + "\n" +
-            nmea("GPGGA,235952.00,0000.0000,N,00000.0000,E,0,00,0.0,,M,,M,,") + "\n");
+      parse(withChecksum("GPRMC,235948.00,V,0000.0000,N,00000.0000,E,,,161206,,,N") + "\n" +
+            withChecksum("GPGGA,235952.00,0000.0000,N,00000.0000,E,0,00,0.0,,M,,M,,") + "\n");
   ASSERT_EQ(run.fixes().size(), 2u);
   EXPECT_FALSE(run.outcomes[0].rmc.valid());
   EXPECT_FALSE(run.outcomes[1].gga.valid());

@@ -36,6 +36,7 @@
 
 #include <fmt/format.h>
 
+#include "fieldrig/gps/nmea_parser.h"
 #include "support/socat_pty.h"
 
 namespace fieldrig::gps {
@@ -52,13 +53,6 @@ namespace fs = std::filesystem;
 constexpr auto kTimeout = 10s;
 
 // ---- NMEA test data ---------------------------------------------------------------------------
-
-std::string withChecksum(std::string_view body) {
-  unsigned char checksum = 0;
-  for (char c : body)
-    checksum ^= static_cast<unsigned char>(c);
-  return fmt::format("${}*{:02X}", body, checksum);
-}
 
 // Sentence i of a 10 Hz stream: GGA and RMC alternate, each with its own time and latitude, so
 // that a reordered, duplicated or spliced sentence cannot compare equal to the one expected.

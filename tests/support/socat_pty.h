@@ -23,6 +23,8 @@
 #include <thread>
 #include <vector>
 
+#include "support/fd_io.h"
+
 namespace fieldrig::testing_support {
 
 namespace socat_detail {
@@ -151,17 +153,7 @@ class Feed {
 
   bool ok() const { return fd_ >= 0; }
 
-  bool write(std::string_view bytes) {
-    while (!bytes.empty()) {
-      const ssize_t n = ::write(fd_, bytes.data(), bytes.size());
-      if (n < 0 && errno == EINTR)
-        continue;
-      if (n <= 0)
-        return false;
-      bytes.remove_prefix(static_cast<std::size_t>(n));
-    }
-    return true;
-  }
+  bool write(std::string_view bytes) { return writeAll(fd_, bytes); }
 
   // Odd chunk sizes so that sentences straddle reads; the pauses let the reader catch up and
   // split the stream at the chunk boundaries rather than the kernel's.

@@ -1,15 +1,12 @@
 // `fieldrig map generate` and `fieldrig map record`, run as the built binary.
 #include <fcntl.h>
 #include <gtest/gtest.h>
-#include <poll.h>
 #include <signal.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include <GeographicLib/Geodesic.hpp>
 #include <GeographicLib/LocalCartesian.hpp>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,14 +15,17 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
-#include <sstream>
-#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "fieldrig/gps/field_plan.h"
 #include "fieldrig/gps/location_map.h"
+#include "fieldrig/gps/nmea_parser.h"
+#include "support/cli_process.h"
+#include "support/cli_run.h"
+#include "support/socat_pty.h"
+#include "support/temp_dir.h"
 
 namespace fieldrig {
 namespace {
@@ -33,180 +33,21 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 using Json = nlohmann::json;
+using testing_support::FieldrigProcess;
+using testing_support::readWholeFile;
+using testing_support::runFieldrig;
+using testing_support::ScopedTempDir;
 
-const std::string kBinary = FIELDRIG_BINARY_DIR "/tools/fieldrig";
-
-// A child process with pipes on stdin, stdout and stderr.
-class Child {
- public:
-  explicit Child(const std::vector<std::string>& args) {
-    int in_pipe[2], out_pipe[2], err_pipe[2];
-    if (::pipe(in_pipe) != 0 || ::pipe(out_pipe) != 0 || ::pipe(err_pipe) != 0)
-      throw std::runtime_error("pipe");
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(in_pipe[0], STDIN_FILENO);
-      ::dup2(out_pipe[1], STDOUT_FILENO);
-      ::dup2(err_pipe[1], STDERR_FILENO);
-      for (int fd : {in_pipe[0], in_pipe[1], out_pipe[0], out_pipe[1], err_pipe[0], err_pipe[1]})
-        ::close(fd);
-      std::vector<char*> argv;
-      argv.push_back(const_cast<char*>(kBinary.c_str()));
-      for (const std::string& arg : args)
-        argv.push_back(const_cast<char*>(arg.c_str()));
-      argv.push_back(nullptr);
-      ::execv(kBinary.c_str(), argv.data());
-      ::_exit(127);
-    }
-    ::close(in_pipe[0]);
-    ::close(out_pipe[1]);
-    ::close(err_pipe[1]);
-    stdin_ = in_pipe[1];
-    stdout_ = out_pipe[0];
-    stderr_ = err_pipe[0];
-  }
-
-  ~Child() {
-    if (pid_ > 0 && !exited_) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-    for (int fd : {stdin_, stdout_, stderr_}) {
-      if (fd >= 0)
-        ::close(fd);
-    }
-  }
-
-  pid_t pid() const { return pid_; }
-  void send(std::string_view text) {
-    ASSERT_EQ(::write(stdin_, text.data(), text.size()), static_cast<ssize_t>(text.size()));
-  }
-
-  // Collects output until `done` holds or the timeout passes; returns whether `done` held.
-  template <typename Predicate>
-  bool pumpUntil(Predicate done, std::chrono::milliseconds timeout) {
-    const auto deadline = Clock::now() + timeout;
-    while (!done()) {
-      const auto left =
-          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-      if (left.count() <= 0)
-        return false;
-      pollfd fds[2] = {{stdout_, POLLIN, 0}, {stderr_, POLLIN, 0}};
-      if (::poll(fds, 2, static_cast<int>(std::min<long>(left.count(), 50))) < 0)
-        return false;
-      bool progress = false;
-      for (int i = 0; i < 2; ++i) {
-        if (fds[i].revents == 0)
-          continue;
-        char buffer[4096];
-        const ssize_t n = ::read(fds[i].fd, buffer, sizeof buffer);
-        if (n > 0) {
-          (i == 0 ? out : err).append(buffer, static_cast<std::size_t>(n));
-          progress = true;
-        }
-      }
-      if (!progress && exited_)
-        return done();
-      if (!progress)
-        reap();
-    }
-    return true;
-  }
-
-  bool waitForStderr(std::string_view needle, std::chrono::milliseconds timeout = 10s) {
-    return pumpUntil([&] { return err.find(needle) != std::string::npos; }, timeout);
-  }
-  bool waitForStdoutLines(std::size_t lines, std::chrono::milliseconds timeout = 10s) {
-    return pumpUntil(
-        [&] { return static_cast<std::size_t>(std::count(out.begin(), out.end(), '\n')) >= lines; },
-        timeout);
-  }
-
-  // Waits for the exit (collecting output); the exit code, or -1 on timeout or a signal.
-  int waitExit(std::chrono::milliseconds timeout = 20s) {
-    pumpUntil([&] { return exited_ && drained(); }, timeout);
-    if (!exited_)
-      return -1;
-    return WIFEXITED(status_) ? WEXITSTATUS(status_) : -1;
-  }
-
-  std::vector<Json> stdoutJson() const {
-    std::vector<Json> lines;
-    std::istringstream in(out);
-    std::string line;
-    while (std::getline(in, line))
-      lines.push_back(Json::parse(line));
-    return lines;
-  }
-
-  std::string out;
-  std::string err;
-
- private:
-  void reap() {
-    if (!exited_ && ::waitpid(pid_, &status_, WNOHANG) == pid_)
-      exited_ = true;
-  }
-  bool drained() {
-    pollfd fds[2] = {{stdout_, POLLIN, 0}, {stderr_, POLLIN, 0}};
-    ::poll(fds, 2, 0);
-    // After the exit, an empty read (POLLHUP without data) means all output is in.
-    for (auto& fd : fds) {
-      if (fd.revents & POLLIN)
-        return false;
-    }
-    return true;
-  }
-
-  pid_t pid_ = -1;
-  int stdin_ = -1, stdout_ = -1, stderr_ = -1;
-  int status_ = 0;
-  bool exited_ = false;
-};
-
-// Runs the binary to completion with empty stdin.
-int runToEnd(const std::vector<std::string>& args, std::string* out, std::string* err) {
-  Child child(args);
-  child.send("");
-  const int code = child.waitExit();
-  if (out)
-    *out = child.out;
-  if (err)
-    *err = child.err;
-  return code;
-}
-
-class TempDir {
- public:
-  explicit TempDir(const std::string& name)
-      : path_(std::filesystem::temp_directory_path() /
-              ("fieldrig_map_cli_" + name + "_" + std::to_string(::getpid()))) {
-    std::filesystem::remove_all(path_);
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() { std::filesystem::remove_all(path_); }
-  std::string operator/(const std::string& file) const { return (path_ / file).string(); }
-
- private:
-  std::filesystem::path path_;
-};
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+// One JSON object per line of `lines` (a mark per line on stdout).
+std::vector<Json> jsonLines(const std::vector<std::string>& lines) {
+  std::vector<Json> objects;
+  for (const std::string& line : lines)
+    objects.push_back(Json::parse(line));
+  return objects;
 }
 
 // ---------------------------------------------------------------------------------------------
 // Synthetic NMEA.
-
-std::string withChecksum(const std::string& body) {
-  unsigned char sum = 0;
-  for (char c : body)
-    sum ^= static_cast<unsigned char>(c);
-  char tail[8];
-  std::snprintf(tail, sizeof tail, "*%02X\r\n", sum);
-  return "$" + body + tail;
-}
 
 // NMEA's dddmm.mmmmmmmm, rounded as a whole so that 41.99999999999 becomes 4200.00000000, not
 // 4159.99999999 rounded to the invalid 4160.00000000.
@@ -251,7 +92,7 @@ std::string nmeaFor(const Epoch& e) {
                           "," + speed + "," + course + ",140726,,," + (e.valid ? "D" : "N");
   const std::string gga = "GPGGA," + timeOfDay(e.t) + "," + position + "," + (e.valid ? "4" : "0") +
                           ",12,0.8,300.0,M,-30.0,M,,";
-  return withChecksum(rmc) + withChecksum(gga);
+  return gps::withChecksum(rmc) + "\r\n" + gps::withChecksum(gga) + "\r\n";
 }
 
 // The driven track in a local east/north frame near Ames, Iowa.
@@ -288,34 +129,34 @@ void writeFile(const std::string& path, const std::string& text) {
 // map generate
 
 TEST(MapCli, GenerateWritesTheFieldPlansMap) {
-  TempDir dir("generate");
-  std::string out, err;
-  const int code = runToEnd({"map",
-                             "generate",
-                             "--row-start",
-                             "42.0105,-93.7452",
-                             "--row-end",
-                             "42.0110,-93.7445",
-                             "--rows",
-                             "3",
-                             "--plots",
-                             "4",
-                             "--plot-length",
-                             "3.048",
-                             "--alley-length",
-                             "1.0",
-                             "--row-spacing",
-                             "2.286",
-                             "--start-offset",
-                             "0.5",
-                             "--left",
-                             "--id-prefix",
-                             "T",
-                             "--out",
-                             dir / "map.csv"},
-                            &out, &err);
-  ASSERT_EQ(code, 0) << err;
-  const Json summary = Json::parse(out);
+  const ScopedTempDir dir("map_cli_generate");
+  const auto run = runFieldrig({"map",
+                                "generate",
+                                "--row-start",
+                                "42.0105,-93.7452",
+                                "--row-end",
+                                "42.0110,-93.7445",
+                                "--rows",
+                                "3",
+                                "--plots",
+                                "4",
+                                "--plot-length",
+                                "3.048",
+                                "--alley-length",
+                                "1.0",
+                                "--row-spacing",
+                                "2.286",
+                                "--start-offset",
+                                "0.5",
+                                "--left",
+                                "--id-prefix",
+                                "T",
+                                "--out",
+                                dir / "map.csv"},
+                               dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  ASSERT_EQ(run.out_lines.size(), 1u) << run.err;
+  const Json summary = Json::parse(run.out_lines[0]);
   EXPECT_EQ(summary["locations"], 12);
   EXPECT_EQ(summary["rows"], 3);
   EXPECT_EQ(summary["plots_per_row"], 4);
@@ -352,21 +193,20 @@ TEST(MapCli, GenerateWritesTheFieldPlansMap) {
 }
 
 TEST(MapCli, GenerateRejectsABadPlan) {
-  TempDir dir("generate_bad");
-  std::string err;
-  EXPECT_EQ(runToEnd({"map", "generate", "--row-start", "42.0105,-93.7452", "--row-end",
-                      "42.0110,-93.7445", "--rows", "0", "--plot-length", "3", "--alley-length",
-                      "1", "--row-spacing", "2", "--out", dir / "map.csv"},
-                     nullptr, &err),
-            2);
-  EXPECT_NE(err.find("field 'rows'"), std::string::npos) << err;
+  const ScopedTempDir dir("map_cli_generate_bad");
+  auto run = runFieldrig({"map", "generate", "--row-start", "42.0105,-93.7452", "--row-end",
+                          "42.0110,-93.7445", "--rows", "0", "--plot-length", "3", "--alley-length",
+                          "1", "--row-spacing", "2", "--out", dir / "map.csv"},
+                         dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("field 'rows'"), std::string::npos) << run.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "map.csv"));
-  EXPECT_EQ(runToEnd({"map", "generate", "--row-start", "42.0105;-93.7452", "--row-end",
-                      "42.0110,-93.7445", "--rows", "1", "--plot-length", "3", "--alley-length",
-                      "1", "--row-spacing", "2", "--out", dir / "map.csv"},
-                     nullptr, &err),
-            2);
-  EXPECT_NE(err.find("--row-start"), std::string::npos) << err;
+  run = runFieldrig({"map", "generate", "--row-start", "42.0105;-93.7452", "--row-end",
+                     "42.0110,-93.7445", "--rows", "1", "--plot-length", "3", "--alley-length", "1",
+                     "--row-spacing", "2", "--out", dir / "map.csv"},
+                    dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("--row-start"), std::string::npos) << run.err;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -404,33 +244,34 @@ std::string twoLegDrive(const Track& track, double& corner_east, double& corner_
 }
 
 TEST(MapCli, RecordFromFileMarksByEnterAndSigusr1) {
-  TempDir dir("record");
+  const ScopedTempDir dir("map_cli_record");
   Track track;
   double corner_east = 0, corner_north = 0;
   writeFile(dir / "drive.nmea", twoLegDrive(track, corner_east, corner_north));
 
-  Child child(
-      {"map", "record", "--nmea", dir / "drive.nmea", "--out", dir / "map.csv", "--realtime"});
-  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err;
+  FieldrigProcess child(
+      {"map", "record", "--nmea", dir / "drive.nmea", "--out", dir / "map.csv", "--realtime"},
+      dir.path());
+  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err();
   const auto start = Clock::now();
   // Before any valid fix: refused, nothing written.
   std::this_thread::sleep_until(start + 400ms);
-  child.send("\n");
-  ASSERT_TRUE(child.waitForStderr("refused")) << child.err;
+  ASSERT_TRUE(child.sendInput("\n"));
+  ASSERT_TRUE(child.waitForStderr("refused")) << child.err();
   // On leg 1, by Enter.
   std::this_thread::sleep_until(start + 2300ms);
-  child.send("\n");
-  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err;
+  ASSERT_TRUE(child.sendInput("\n"));
+  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err();
   // On leg 2, by SIGUSR1.
   std::this_thread::sleep_until(start + 5000ms);
-  ASSERT_EQ(::kill(child.pid(), SIGUSR1), 0);
-  ASSERT_TRUE(child.waitForStdoutLines(2)) << child.err;
+  ASSERT_TRUE(child.signal(SIGUSR1));
+  ASSERT_TRUE(child.waitForStdoutLines(2)) << child.err();
   // The file ends at 6 s, and so does the command.
-  ASSERT_EQ(child.waitExit(), 0) << child.err;
-  EXPECT_NE(child.err.find("2 marks written"), std::string::npos) << child.err;
+  ASSERT_EQ(child.waitExit(), 0) << child.err();
+  EXPECT_NE(child.err().find("2 marks written"), std::string::npos) << child.err();
 
-  const std::vector<Json> marks = child.stdoutJson();
-  ASSERT_EQ(marks.size(), 2u) << child.out;
+  const std::vector<Json> marks = jsonLines(child.outLines());
+  ASSERT_EQ(marks.size(), 2u) << child.out();
   EXPECT_EQ(marks[0]["id"], "P1");
   EXPECT_EQ(marks[0]["trigger"], "enter");
   EXPECT_EQ(marks[0]["heading_source"], "course");
@@ -471,7 +312,7 @@ TEST(MapCli, RecordFromFileMarksByEnterAndSigusr1) {
 }
 
 TEST(MapCli, RecordContinuesAnExistingMapAndRefusesStaleFixes) {
-  TempDir dir("record_continue");
+  const ScopedTempDir dir("map_cli_record_continue");
   const std::string header = "id,lat,lon,heading,time,speed_mps,quality\n";
   const std::string existing = "# recorded yesterday\n" + header +
                                "P7,42.001,-93.601,10,2026-07-13T15:00:00.000Z,1.500,4\n"
@@ -492,24 +333,25 @@ TEST(MapCli, RecordContinuesAnExistingMapAndRefusesStaleFixes) {
   nmea += nmeaFor(last);
   writeFile(dir / "drive.nmea", nmea);
 
-  Child child({"map", "record", "--nmea", dir / "drive.nmea", "--out", dir / "map.csv"});
-  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err;
-  EXPECT_NE(child.err.find("2 locations already there"), std::string::npos) << child.err;
+  FieldrigProcess child({"map", "record", "--nmea", dir / "drive.nmea", "--out", dir / "map.csv"},
+                        dir.path());
+  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err();
+  EXPECT_NE(child.err().find("2 locations already there"), std::string::npos) << child.err();
   const auto start = Clock::now();
   std::this_thread::sleep_until(start + 700ms);
-  child.send("\n");
-  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err;
+  ASSERT_TRUE(child.sendInput("\n"));
+  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err();
   // 4.2 s: the latest fix (1.5 s) is 2.7 s old.
   std::this_thread::sleep_until(start + 4200ms);
-  child.send("\n");
-  ASSERT_TRUE(child.waitForStderr("s old; nothing written")) << child.err;
-  ASSERT_EQ(child.waitExit(), 0) << child.err;
+  ASSERT_TRUE(child.sendInput("\n"));
+  ASSERT_TRUE(child.waitForStderr("s old; nothing written")) << child.err();
+  ASSERT_EQ(child.waitExit(), 0) << child.err();
 
-  const std::vector<Json> marks = child.stdoutJson();
-  ASSERT_EQ(marks.size(), 1u) << child.out;
+  const std::vector<Json> marks = jsonLines(child.outLines());
+  ASSERT_EQ(marks.size(), 1u) << child.out();
   EXPECT_EQ(marks[0]["id"], "P8");  // one past the highest P number
 
-  const std::string text = readFile(dir / "map.csv");
+  const std::string text = readWholeFile(dir / "map.csv");
   // The old text is kept byte for byte, the missing newline added, the header not repeated.
   ASSERT_EQ(text.rfind(existing + "\n", 0), 0u) << text;
   EXPECT_EQ(text.find(header), text.rfind(header));
@@ -527,34 +369,34 @@ TEST(MapCli, RecordContinuesAnExistingMapAndRefusesStaleFixes) {
 }
 
 TEST(MapCli, RecordRefusesAnIncompatibleExistingMap) {
-  TempDir dir("record_incompatible");
+  const ScopedTempDir dir("map_cli_record_incompatible");
   writeFile(dir / "drive.nmea", nmeaFor(Track{}.at(0, 0, 0)));
   const std::string other = "id,lat,lon,plot\nA,42,-93,1\n";
   writeFile(dir / "map.csv", other);
-  std::string err;
-  EXPECT_EQ(runToEnd({"map", "record", "--nmea", dir / "drive.nmea", "--out", dir / "map.csv"},
-                     nullptr, &err),
-            2);
-  EXPECT_NE(err.find("is not the recording header"), std::string::npos) << err;
-  EXPECT_EQ(readFile(dir / "map.csv"), other);
+  const std::vector<std::string> record = {"map",   "record",       "--nmea", dir / "drive.nmea",
+                                           "--out", dir / "map.csv"};
+  auto run = runFieldrig(record, dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("is not the recording header"), std::string::npos) << run.err;
+  EXPECT_EQ(readWholeFile(dir / "map.csv"), other);
 
   // A broken map is reported with its line.
   writeFile(dir / "map.csv", "id,lat,lon,heading,time,speed_mps,quality\nA,95,-93,,,,\n");
-  EXPECT_EQ(runToEnd({"map", "record", "--nmea", dir / "drive.nmea", "--out", dir / "map.csv"},
-                     nullptr, &err),
-            2);
-  EXPECT_NE(err.find("map.csv:2: field 'lat': 95 is outside"), std::string::npos) << err;
+  run = runFieldrig(record, dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("map.csv:2: field 'lat': 95 is outside"), std::string::npos) << run.err;
 }
 
 TEST(MapCli, RecordFromAFifo) {
-  TempDir dir("record_fifo");
+  const ScopedTempDir dir("map_cli_record_fifo");
   const std::string fifo = dir / "gps.fifo";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-  Child child({"map", "record", "--nmea", fifo, "--out", dir / "map.csv", "--id-prefix", "F",
-               "--start-id", "100"});
+  FieldrigProcess child({"map", "record", "--nmea", fifo, "--out", dir / "map.csv", "--id-prefix",
+                         "F", "--start-id", "100"},
+                        dir.path());
   const int writer = ::open(fifo.c_str(), O_WRONLY);  // meets the recorder's open
   ASSERT_GE(writer, 0);
-  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err;
+  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err();
   Track track;
   std::string nmea;
   for (int i = 0; i < 10; ++i) {
@@ -565,11 +407,11 @@ TEST(MapCli, RecordFromAFifo) {
   }
   ASSERT_EQ(::write(writer, nmea.data(), nmea.size()), static_cast<ssize_t>(nmea.size()));
   std::this_thread::sleep_for(300ms);
-  child.send("\n");
-  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err;
+  ASSERT_TRUE(child.sendInput("\n"));
+  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err();
   ::close(writer);  // end of input ends the command
-  ASSERT_EQ(child.waitExit(), 0) << child.err;
-  const std::vector<Json> marks = child.stdoutJson();
+  ASSERT_EQ(child.waitExit(), 0) << child.err();
+  const std::vector<Json> marks = jsonLines(child.outLines());
   ASSERT_EQ(marks.size(), 1u);
   EXPECT_EQ(marks[0]["id"], "F100");
   EXPECT_EQ(marks[0]["heading_deg"], 270.0);
@@ -582,34 +424,18 @@ TEST(MapCli, RecordFromAFifo) {
 
 // Through a real pseudo-terminal pair, as from the receiver's serial port.
 TEST(MapCli, RecordFromASerialPty) {
-  if (::access("/usr/bin/socat", X_OK) != 0)
-    GTEST_SKIP() << "socat is not installed";
-  TempDir dir("record_pty");
-  const std::string device = dir / "gps", feed = dir / "feed";
-  const pid_t socat = ::fork();
-  if (socat == 0) {
-    const std::string a = "pty,raw,echo=0,link=" + device, b = "pty,raw,echo=0,link=" + feed;
-    ::execl("/usr/bin/socat", "socat", a.c_str(), b.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  struct KillSocat {
-    pid_t pid;
-    ~KillSocat() {
-      ::kill(pid, SIGTERM);
-      ::waitpid(pid, nullptr, 0);
-    }
-  } kill_socat{socat};
-  const auto deadline = Clock::now() + 5s;
-  while (!(std::filesystem::exists(device) && std::filesystem::exists(feed)) &&
-         Clock::now() < deadline) {
-    std::this_thread::sleep_for(20ms);
-  }
-  ASSERT_TRUE(std::filesystem::exists(device) && std::filesystem::exists(feed));
+  const ScopedTempDir dir("map_cli_record_pty");
+  // socat is required: the project's test command installs it, so its absence is a failure.
+  testing_support::SocatPty pty(dir.path());
+  const std::string started = pty.start();
+  ASSERT_EQ(started, "") << started;
 
-  Child child({"map", "record", "--nmea", device, "--out", dir / "map.csv", "--baud", "38400"});
-  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err;
-  const int writer = ::open(feed.c_str(), O_WRONLY | O_NOCTTY);
-  ASSERT_GE(writer, 0);
+  FieldrigProcess child(
+      {"map", "record", "--nmea", pty.device(), "--out", dir / "map.csv", "--baud", "38400"},
+      dir.path());
+  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err();
+  testing_support::Feed feed(pty.feed());
+  ASSERT_TRUE(feed.ok());
   Track track;
   const auto start = Clock::now();
   bool marked = false;
@@ -619,20 +445,19 @@ TEST(MapCli, RecordFromASerialPty) {
     e.speed_mps = 1.0;
     e.course = 180.0;
     const std::string text = nmeaFor(e);
-    ASSERT_EQ(::write(writer, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+    ASSERT_TRUE(feed.write(text));
     if (i == 12) {
       std::this_thread::sleep_for(30ms);  // let the epoch arrive before the mark
-      child.send("\n");
+      ASSERT_TRUE(child.sendInput("\n"));
       marked = true;
     }
   }
   ASSERT_TRUE(marked);
-  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err;
-  ::kill(child.pid(), SIGINT);
-  ASSERT_EQ(child.waitExit(), 0) << child.err;
-  ::close(writer);
+  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err();
+  ASSERT_TRUE(child.signal(SIGINT));
+  ASSERT_EQ(child.waitExit(), 0) << child.err();
 
-  const std::vector<Json> marks = child.stdoutJson();
+  const std::vector<Json> marks = jsonLines(child.outLines());
   ASSERT_EQ(marks.size(), 1u);
   EXPECT_EQ(marks[0]["id"], "P1");
   EXPECT_EQ(marks[0]["heading_deg"], 180.0);

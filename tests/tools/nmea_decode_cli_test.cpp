@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -13,51 +12,28 @@
 #include <string>
 #include <vector>
 
+#include "fieldrig/gps/nmea_parser.h"
+#include "support/cli_run.h"
+#include "support/temp_dir.h"
+
+namespace fieldrig {
 namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
+using gps::withChecksum;
+using testing_support::CliRun;
+using testing_support::readWholeFile;
+using testing_support::ScopedTempDir;
 
-const std::string kFieldrig = FIELDRIG_BINARY_DIR "/tools/fieldrig";
 const fs::path kGpsdDir = fs::path(FIELDRIG_SHARED_DATA_DIR) / "nmea" / "gpsd";
 
-struct CliRun {
-  int exit_code = -1;
-  std::vector<std::string> lines;  // stdout
-  std::string error;               // stderr
-};
-
-std::string readFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream out;
-  out << in.rdbuf();
-  return out.str();
+// `fieldrig nmea decode FILE`, its outputs kept in `dir`.
+CliRun decode(const fs::path& file, const ScopedTempDir& dir) {
+  return testing_support::runFieldrig({"nmea", "decode", file.string()}, dir.path());
 }
 
-CliRun decode(const fs::path& file) {
-  const fs::path out = fs::path(testing::TempDir()) / "nmea_decode_cli_test.out";
-  const fs::path err = fs::path(testing::TempDir()) / "nmea_decode_cli_test.err";
-  const std::string command = "'" + kFieldrig + "' nmea decode '" + file.string() + "' >'" +
-                              out.string() + "' 2>'" + err.string() + "'";
-  CliRun run;
-  const int status = std::system(command.c_str());
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::istringstream stdout_text(readFile(out));
-  for (std::string line; std::getline(stdout_text, line);)
-    run.lines.push_back(line);
-  run.error = readFile(err);
-  return run;
-}
-
-std::string nmea(const std::string& body) {
-  unsigned char sum = 0;
-  for (char c : body)
-    sum ^= static_cast<unsigned char>(c);
-  char tail[4];
-  std::snprintf(tail, sizeof tail, "%02X", sum);
-  return "$" + body + "*" + tail;
-}
-
+// Checked here without the library: the intact sentences of a gpsd log are found independently.
 bool checksumOk(const std::string& sentence) {
   const std::size_t star = sentence.rfind('*');
   if (star == std::string::npos || star + 3 != sentence.size())
@@ -71,23 +47,23 @@ bool checksumOk(const std::string& sentence) {
 // Checks every output line against the contract; returns the objects (summary excluded).
 std::vector<Json> checkContract(const CliRun& run, Json& summary) {
   std::vector<Json> objects;
-  EXPECT_FALSE(run.lines.empty());
-  for (std::size_t i = 0; i < run.lines.size(); ++i) {
+  EXPECT_FALSE(run.out_lines.empty());
+  for (std::size_t i = 0; i < run.out_lines.size(); ++i) {
     Json line;
     try {
-      line = Json::parse(run.lines[i]);
+      line = Json::parse(run.out_lines[i]);
     } catch (const Json::parse_error& e) {
-      ADD_FAILURE() << "line " << i + 1 << " is not JSON: " << run.lines[i];
+      ADD_FAILURE() << "line " << i + 1 << " is not JSON: " << run.out_lines[i];
       continue;
     }
-    if (i + 1 == run.lines.size()) {
-      EXPECT_TRUE(line.contains("summary")) << run.lines[i];
+    if (i + 1 == run.out_lines.size()) {
+      EXPECT_TRUE(line.contains("summary")) << run.out_lines[i];
       summary = line["summary"];
       continue;
     }
     EXPECT_TRUE(line.is_object());
     const std::string kind = line.value("sentence", "");
-    EXPECT_TRUE(kind == "RMC" || kind == "GGA") << run.lines[i];
+    EXPECT_TRUE(kind == "RMC" || kind == "GGA") << run.out_lines[i];
     std::vector<std::string> required = {"sentence", "talker", "lat", "lon"};
     if (kind == "RMC") {
       required.insert(required.end(), {"time", "valid", "speed_mps", "course_deg"});
@@ -96,7 +72,7 @@ std::vector<Json> checkContract(const CliRun& run, Json& summary) {
                       {"time_of_day", "quality", "satellites", "hdop", "altitude_m"});
     }
     for (const std::string& field : required) {
-      EXPECT_TRUE(line.contains(field)) << field << " missing: " << run.lines[i];
+      EXPECT_TRUE(line.contains(field)) << field << " missing: " << run.out_lines[i];
     }
     if (kind == "RMC") {
       EXPECT_TRUE(line["valid"].is_boolean());
@@ -121,8 +97,9 @@ TEST(NmeaDecodeCli, GpsdLogsFollowTheContractInInputOrder) {
   for (const std::string name :
        {"cat-ms352.log", "gp-320fw-2019-04-07-coldboot.log", "triton400.log", "nmea-rtk.log"}) {
     SCOPED_TRACE(name);
-    const CliRun run = decode(kGpsdDir / name);
-    ASSERT_EQ(run.exit_code, 0) << run.error;
+    const ScopedTempDir dir("nmea_decode_cli_gpsd");
+    const CliRun run = decode(kGpsdDir / name, dir);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
     Json summary;
     const std::vector<Json> objects = checkContract(run, summary);
 
@@ -130,7 +107,7 @@ TEST(NmeaDecodeCli, GpsdLogsFollowTheContractInInputOrder) {
     // XOR checksum. Comment lines ('#') are not data.
     std::vector<std::pair<std::string, std::string>> expected;  // type, hh:mm:ss
     int comments = 0;
-    std::istringstream data(readFile(kGpsdDir / name));
+    std::istringstream data(readWholeFile(kGpsdDir / name));
     for (std::string line; std::getline(data, line);) {
       while (!line.empty() && (line.back() == '\r' || line.back() == ' '))
         line.pop_back();
@@ -175,13 +152,13 @@ TEST(NmeaDecodeCli, GpsdLogsFollowTheContractInInputOrder) {
 TEST(NmeaDecodeCli, CorruptLinesNeverYieldAnObject) {
   // Good sentences at latitude 40°, corrupt ones at 11°: no output may be near 11°.
   const std::string good_rmc =
-      nmea("GNRMC,120000.10,A,4000.12345678,N,08800.12345678,W,1.944,45.0,140726,,,R");
-  const std::string good_gga =
-      nmea("GNGGA,120000.10,4000.12345678,N,08800.12345678,W,4,17,0.7,221.5,M,-33.4,M,1.0,0000");
+      withChecksum("GNRMC,120000.10,A,4000.12345678,N,08800.12345678,W,1.944,45.0,140726,,,R");
+  const std::string good_gga = withChecksum(
+      "GNGGA,120000.10,4000.12345678,N,08800.12345678,W,4,17,0.7,221.5,M,-33.4,M,1.0,0000");
   const std::string bad_rmc =
-      nmea("GNRMC,120000.20,A,1100.12345678,N,08800.12345678,W,1.944,45.0,140726,,,R");
-  const std::string bad_gga =
-      nmea("GNGGA,120000.20,1100.12345678,N,08800.12345678,W,4,17,0.7,221.5,M,-33.4,M,1.0,0000");
+      withChecksum("GNRMC,120000.20,A,1100.12345678,N,08800.12345678,W,1.944,45.0,140726,,,R");
+  const std::string bad_gga = withChecksum(
+      "GNGGA,120000.20,1100.12345678,N,08800.12345678,W,4,17,0.7,221.5,M,-33.4,M,1.0,0000");
   std::string wrong_checksum = bad_rmc;
   wrong_checksum.back() = wrong_checksum.back() == 'A' ? 'B' : 'A';
   std::string nul_inside = bad_gga;
@@ -193,11 +170,12 @@ TEST(NmeaDecodeCli, CorruptLinesNeverYieldAnObject) {
       "\r\n" + wrong_checksum + "\r\n" + bad_gga.substr(0, 40) + "\r\n" + nul_inside + "\r\n" +
       "$GNGGA,120000" + good_rmc + "\r\n" + flipped + "\r\n" + "line noise \x01\x02\r\n" +
       "$GPTXT," + std::string(400, 'x') + "\r\n" + good_gga;  // no final terminator
-  const fs::path file = fs::path(testing::TempDir()) / "nmea_decode_cli_test_corrupt.nmea";
+  const ScopedTempDir dir("nmea_decode_cli_corrupt");
+  const fs::path file = dir / "corrupt.nmea";
   std::ofstream(file, std::ios::binary) << file_text;
 
-  const CliRun run = decode(file);
-  ASSERT_EQ(run.exit_code, 0) << run.error;
+  const CliRun run = decode(file, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
   Json summary;
   const std::vector<Json> objects = checkContract(run, summary);
   ASSERT_EQ(objects.size(), 4u);
@@ -233,12 +211,14 @@ TEST(NmeaDecodeCli, CorruptLinesNeverYieldAnObject) {
 
 TEST(NmeaDecodeCli, MissingFileIsAnErrorNamingIt) {
   const std::string missing = "/nonexistent/fieldrig-no-such-file.nmea";
-  const CliRun run = decode(missing);
+  const ScopedTempDir dir("nmea_decode_cli_missing");
+  const CliRun run = decode(missing, dir);
   EXPECT_NE(run.exit_code, 0);
-  EXPECT_NE(run.error.find(missing), std::string::npos) << run.error;
+  EXPECT_NE(run.err.find(missing), std::string::npos) << run.err;
   // No summary pretends the file was read.
-  for (const std::string& line : run.lines)
+  for (const std::string& line : run.out_lines)
     EXPECT_EQ(line.find("summary"), std::string::npos);
 }
 
 }  // namespace
+}  // namespace fieldrig

@@ -8,8 +8,10 @@
 #include "fieldrig/gps/field_plan.h"
 #include "fieldrig/sim/drive_simulator.h"
 #include "fieldrig/sim/trigger_accuracy.h"
+#include "support/cli_process.h"
 #include "support/cli_run.h"
 #include "support/socat_pty.h"
+#include "support/temp_dir.h"
 
 namespace fieldrig {
 namespace {
@@ -19,9 +21,7 @@ using namespace std::chrono_literals;
 using Json = nlohmann::json;
 
 TEST(TriggersLiveCliTest, FiresEveryLocationOnceFromASerialDevice) {
-  const fs::path dir =
-      fs::path(::testing::TempDir()) / ("triggers_live_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const testing_support::ScopedTempDir dir("triggers_live");
   gps::FieldPlan plan;
   plan.row_start_latitude_deg = 41.99;
   plan.row_start_longitude_deg = -93.64;
@@ -38,26 +38,12 @@ TEST(TriggersLiveCliTest, FiresEveryLocationOnceFromASerialDevice) {
   options.headland_m = 2.0;
   const sim::DriveSimulator drive(plan, options);
 
-  testing_support::SocatPty pty(dir);
+  testing_support::SocatPty pty(dir.path());
   const std::string started = pty.start();
   ASSERT_EQ(started, "") << started;
 
-  const fs::path out = dir / "triggers.jsonl";
-  const fs::path err = dir / "triggers.err";
-  const pid_t child = ::fork();
-  if (child == 0) {
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    const int out_fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int err_fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(out_fd, STDOUT_FILENO);
-    ::dup2(err_fd, STDERR_FILENO);
-    const std::string map_path = (dir / "map.csv").string();
-    const std::string device = pty.device().string();
-    ::execl(testing_support::kFieldrigBinary.c_str(), "fieldrig", "triggers", "--map",
-            map_path.c_str(), "--nmea", device.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  ASSERT_GT(child, 0);
+  testing_support::FieldrigProcess triggers(
+      {"triggers", "--map", dir / "map.csv", "--nmea", pty.device()}, dir.path());
   std::this_thread::sleep_for(300ms);  // let it open the device
 
   // Write each epoch's sentences at its GPS time (relative to the drive's start).
@@ -71,14 +57,11 @@ TEST(TriggersLiveCliTest, FiresEveryLocationOnceFromASerialDevice) {
     ASSERT_TRUE(feed.write(epoch));
   }
   std::this_thread::sleep_for(300ms);
-  ::kill(child, SIGINT);
-  int status = 0;
-  ::waitpid(child, &status, 0);
-  ASSERT_TRUE(WIFEXITED(status)) << testing_support::readWholeFile(err);
-  EXPECT_EQ(WEXITSTATUS(status), 0) << testing_support::readWholeFile(err);
+  ASSERT_TRUE(triggers.signal(SIGINT)) << triggers.err();
+  ASSERT_EQ(triggers.waitExit(), 0) << triggers.err();
 
   std::vector<core::TriggerEvent> events;
-  for (const std::string& text : testing_support::splitLines(testing_support::readWholeFile(out))) {
+  for (const std::string& text : triggers.outLines()) {
     const Json line = Json::parse(text);
     core::TriggerEvent event;
     event.location_id = line["location"];
@@ -87,12 +70,11 @@ TEST(TriggersLiveCliTest, FiresEveryLocationOnceFromASerialDevice) {
     EXPECT_TRUE(line.contains("host_time"));
   }
   const sim::TriggerAccuracy accuracy = sim::scoreTriggers(drive, *map, events);
-  EXPECT_EQ(accuracy.fired_once, map->size()) << testing_support::readWholeFile(err);
+  EXPECT_EQ(accuracy.fired_once, map->size()) << triggers.err();
   // The planned GPS times are as accurate as in replay; the host clock only decides when.
   EXPECT_LT(accuracy.max_abs_m, 0.04);
-  const std::string log = testing_support::readWholeFile(err);
+  const std::string log = triggers.err();
   EXPECT_NE(log.find("\"summary\""), std::string::npos) << log;
-  fs::remove_all(dir);
 }
 
 }  // namespace
