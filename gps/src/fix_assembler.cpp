@@ -8,7 +8,8 @@ constexpr auto kDay = std::chrono::days{1};
 FixAssembler::FixAssembler(std::chrono::sys_days fallback_date) : fallback_date_(fallback_date) {}
 
 std::optional<core::UtcTime> FixAssembler::dateTimeFor(core::Nanoseconds time_of_day) {
-  if (!last_rmc_time_) return core::UtcTime{fallback_date_} + time_of_day;
+  if (!last_rmc_time_)
+    return core::UtcTime{fallback_date_} + time_of_day;
   // The GGA belongs to the day whose instant is nearest the last RMC's: this handles a GGA just
   // after midnight following an RMC of the previous day, and the reverse.
   const auto rmc_day = std::chrono::floor<std::chrono::days>(*last_rmc_time_);
@@ -26,7 +27,8 @@ std::optional<core::GpsFix> FixAssembler::add(const Sentence& sentence,
   std::optional<core::UtcTime> time;
   bool has_date = false;
   if (sentence.kind == SentenceKind::kRmc) {
-    if (!sentence.rmc.time_of_day) return std::nullopt;
+    if (!sentence.rmc.time_of_day)
+      return std::nullopt;
     if (sentence.rmc.time) {
       time = sentence.rmc.time;
       has_date = true;
@@ -35,7 +37,8 @@ std::optional<core::GpsFix> FixAssembler::add(const Sentence& sentence,
       time = dateTimeFor(*sentence.rmc.time_of_day);
     }
   } else if (sentence.kind == SentenceKind::kGga) {
-    if (!sentence.gga.time_of_day) return std::nullopt;
+    if (!sentence.gga.time_of_day)
+      return std::nullopt;
     time = dateTimeFor(*sentence.gga.time_of_day);
     has_date = last_rmc_time_.has_value();
   } else {

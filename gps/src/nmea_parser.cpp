@@ -14,7 +14,9 @@ struct Fields {
   std::array<std::string_view, kMaxFields> values{};
   std::size_t count = 0;
 
-  std::string_view operator[](std::size_t i) const { return i < count ? values[i] : std::string_view{}; }
+  std::string_view operator[](std::size_t i) const {
+    return i < count ? values[i] : std::string_view{};
+  }
 };
 
 Fields splitFields(std::string_view payload) {
@@ -23,36 +25,45 @@ Fields splitFields(std::string_view payload) {
   std::size_t start = 0;
   // A plain loop: this runs for every sentence, and the fields are short.
   for (std::size_t i = 0; i < payload.size(); ++i) {
-    if (data[i] != ',') continue;
+    if (data[i] != ',')
+      continue;
     fields.values[fields.count++] = std::string_view(data + start, i - start);
     start = i + 1;
-    if (fields.count == kMaxFields) return fields;
+    if (fields.count == kMaxFields)
+      return fields;
   }
   fields.values[fields.count++] = std::string_view(data + start, payload.size() - start);
   return fields;
 }
 
-bool isSentenceStart(char c) { return c == '$' || c == '!'; }
+bool isSentenceStart(char c) {
+  return c == '$' || c == '!';
+}
 
 // Index of the next '$' or '!' at or after `from`, or npos. (string_view::find_first_of calls
 // memchr once per byte, which made it the parser's hottest spot.)
 std::size_t findSentenceStart(std::string_view line, std::size_t from) {
   for (std::size_t i = from; i < line.size(); ++i) {
-    if (isSentenceStart(line[i])) return i;
+    if (isSentenceStart(line[i]))
+      return i;
   }
   return std::string_view::npos;
 }
 
 int hexValue(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= '0' && c <= '9')
+    return c - '0';
+  if (c >= 'A' && c <= 'F')
+    return c - 'A' + 10;
+  if (c >= 'a' && c <= 'f')
+    return c - 'a' + 10;
   return -1;
 }
 
 bool isDigits(std::string_view text) {
   for (char c : text) {
-    if (c < '0' || c > '9') return false;
+    if (c < '0' || c > '9')
+      return false;
   }
   return true;
 }
@@ -67,7 +78,8 @@ bool parseDecimal(std::string_view text, double& out) {
                                       1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
   std::size_t i = 0;
   const bool negative = !text.empty() && text.front() == '-';
-  if (negative) i = 1;
+  if (negative)
+    i = 1;
   std::uint64_t mantissa = 0;
   int digits = 0;
   int fraction_digits = 0;
@@ -75,16 +87,19 @@ bool parseDecimal(std::string_view text, double& out) {
   for (; i < text.size(); ++i) {
     const char c = text[i];
     if (c >= '0' && c <= '9') {
-      if (digits < 19) mantissa = mantissa * 10 + static_cast<std::uint64_t>(c - '0');
+      if (digits < 19)
+        mantissa = mantissa * 10 + static_cast<std::uint64_t>(c - '0');
       ++digits;
-      if (dot_seen) ++fraction_digits;
+      if (dot_seen)
+        ++fraction_digits;
     } else if (c == '.' && !dot_seen) {
       dot_seen = true;
     } else {
       return false;
     }
   }
-  if (digits == 0) return false;
+  if (digits == 0)
+    return false;
   if (digits <= 15) {
     const double value = static_cast<double>(mantissa) / kPow10[fraction_digits];
     out = negative ? -value : value;
@@ -97,20 +112,25 @@ bool parseDecimal(std::string_view text, double& out) {
 // Field decoders: return false when the field is present but cannot be decoded (the sentence is
 // then rejected as malformed); an empty field leaves the optional empty.
 bool decodeDouble(std::string_view text, std::optional<double>& out) {
-  if (text.empty()) return true;
+  if (text.empty())
+    return true;
   double value = 0;
   // Some receivers send a leading '+'.
-  if (text.front() == '+') text.remove_prefix(1);
-  if (!parseDecimal(text, value)) return false;
+  if (text.front() == '+')
+    text.remove_prefix(1);
+  if (!parseDecimal(text, value))
+    return false;
   out = value;
   return true;
 }
 
 bool decodeInt(std::string_view text, std::optional<int>& out) {
-  if (text.empty()) return true;
+  if (text.empty())
+    return true;
   int value = 0;
   const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || ptr != text.data() + text.size()) return false;
+  if (ec != std::errc() || ptr != text.data() + text.size())
+    return false;
   out = value;
   return true;
 }
@@ -119,21 +139,29 @@ bool decodeInt(std::string_view text, std::optional<int>& out) {
 // that the minutes keep every digit the receiver sent.
 bool decodeCoordinate(std::string_view value, std::string_view hemisphere, int max_degrees,
                       std::optional<double>& out) {
-  if (value.empty() && hemisphere.empty()) return true;
-  if (value.empty() || hemisphere.size() != 1) return false;
+  if (value.empty() && hemisphere.empty())
+    return true;
+  if (value.empty() || hemisphere.size() != 1)
+    return false;
   const std::size_t dot = value.find('.');
   const std::size_t integer_digits = dot == std::string_view::npos ? value.size() : dot;
-  if (integer_digits < 3 || integer_digits > 5) return false;
+  if (integer_digits < 3 || integer_digits > 5)
+    return false;
   const std::string_view degree_text = value.substr(0, integer_digits - 2);
   const std::string_view minute_text = value.substr(integer_digits - 2);
-  if (!isDigits(degree_text) || !isDigits(minute_text.substr(0, 2))) return false;
+  if (!isDigits(degree_text) || !isDigits(minute_text.substr(0, 2)))
+    return false;
   int degrees = 0;
-  for (char c : degree_text) degrees = degrees * 10 + (c - '0');
+  for (char c : degree_text)
+    degrees = degrees * 10 + (c - '0');
   double minutes = 0;
-  if (!parseDecimal(minute_text, minutes)) return false;
-  if (minutes >= 60.0 || degrees > max_degrees) return false;
+  if (!parseDecimal(minute_text, minutes))
+    return false;
+  if (minutes >= 60.0 || degrees > max_degrees)
+    return false;
   double decimal = degrees + minutes / 60.0;
-  if (decimal > max_degrees) return false;
+  if (decimal > max_degrees)
+    return false;
   switch (hemisphere.front()) {
     case 'N':
     case 'E':
@@ -151,16 +179,20 @@ bool decodeCoordinate(std::string_view value, std::string_view hemisphere, int m
 
 // "hhmmss[.s…]" to nanoseconds since midnight, exact (no floating point).
 bool decodeTimeOfDay(std::string_view text, std::optional<core::Nanoseconds>& out) {
-  if (text.empty()) return true;
-  if (text.size() < 6 || !isDigits(text.substr(0, 6))) return false;
+  if (text.empty())
+    return true;
+  if (text.size() < 6 || !isDigits(text.substr(0, 6)))
+    return false;
   const int hours = (text[0] - '0') * 10 + (text[1] - '0');
   const int minutes = (text[2] - '0') * 10 + (text[3] - '0');
   const int seconds = (text[4] - '0') * 10 + (text[5] - '0');
-  if (hours > 23 || minutes > 59 || seconds > 60) return false;
+  if (hours > 23 || minutes > 59 || seconds > 60)
+    return false;
   std::int64_t nanos = 0;
   if (text.size() > 6) {
     const std::string_view fraction = text.substr(7);
-    if (text[6] != '.' || fraction.size() > 9 || !isDigits(fraction)) return false;
+    if (text[6] != '.' || fraction.size() > 9 || !isDigits(fraction))
+      return false;
     std::int64_t scale = 100'000'000;
     for (char c : fraction) {
       nanos += (c - '0') * scale;
@@ -174,15 +206,18 @@ bool decodeTimeOfDay(std::string_view text, std::optional<core::Nanoseconds>& ou
 
 // "ddmmyy"; two-digit years 80-99 are 19xx, as in gpsd.
 bool decodeDate(std::string_view text, std::optional<std::chrono::sys_days>& out) {
-  if (text.empty()) return true;
-  if (text.size() != 6 || !isDigits(text)) return false;
+  if (text.empty())
+    return true;
+  if (text.size() != 6 || !isDigits(text))
+    return false;
   const unsigned day = static_cast<unsigned>((text[0] - '0') * 10 + (text[1] - '0'));
   const unsigned month = static_cast<unsigned>((text[2] - '0') * 10 + (text[3] - '0'));
   const int two_digit_year = (text[4] - '0') * 10 + (text[5] - '0');
   const int year = two_digit_year < 80 ? 2000 + two_digit_year : 1900 + two_digit_year;
   const std::chrono::year_month_day ymd{std::chrono::year{year}, std::chrono::month{month},
                                         std::chrono::day{day}};
-  if (!ymd.ok()) return false;
+  if (!ymd.ok())
+    return false;
   out = std::chrono::sys_days{ymd};
   return true;
 }
@@ -200,43 +235,64 @@ bool decodeRmc(const Fields& f, RmcData& rmc, std::string_view& bad_field) {
   std::optional<std::chrono::sys_days> date;
   std::optional<double> speed_knots;
   std::optional<double> variation;
-  if (!decodeTimeOfDay(f[1], rmc.time_of_day)) return bad_field = "time", false;
-  if (f[2].size() > 1) return bad_field = "status", false;
+  if (!decodeTimeOfDay(f[1], rmc.time_of_day))
+    return bad_field = "time", false;
+  if (f[2].size() > 1)
+    return bad_field = "status", false;
   rmc.status_active = f[2] == "A";
-  if (!decodeCoordinate(f[3], f[4], 90, rmc.latitude_deg)) return bad_field = "lat", false;
-  if (!decodeCoordinate(f[5], f[6], 180, rmc.longitude_deg)) return bad_field = "lon", false;
+  if (!decodeCoordinate(f[3], f[4], 90, rmc.latitude_deg))
+    return bad_field = "lat", false;
+  if (!decodeCoordinate(f[5], f[6], 180, rmc.longitude_deg))
+    return bad_field = "lon", false;
   // Half a position is no position: a sentence with only one of them is cut or corrupt.
   if (rmc.latitude_deg.has_value() != rmc.longitude_deg.has_value()) {
     return bad_field = "position", false;
   }
-  if (!decodeDouble(f[7], speed_knots)) return bad_field = "speed", false;
-  if (!decodeDouble(f[8], rmc.course_deg)) return bad_field = "course", false;
-  if (!decodeDate(f[9], date)) return bad_field = "date", false;
-  if (!decodeDouble(f[10], variation)) return bad_field = "magnetic_variation", false;
-  if (f[12].size() > 1) return bad_field = "mode", false;
-  if (f[12].size() == 1) rmc.mode = f[12].front();
-  if (speed_knots) rmc.speed_mps = *speed_knots * kMetresPerSecondPerKnot;
-  if (variation) rmc.magnetic_variation_deg = f[11] == "W" ? -*variation : *variation;
-  if (date && rmc.time_of_day) rmc.time = core::UtcTime{*date} + *rmc.time_of_day;
+  if (!decodeDouble(f[7], speed_knots))
+    return bad_field = "speed", false;
+  if (!decodeDouble(f[8], rmc.course_deg))
+    return bad_field = "course", false;
+  if (!decodeDate(f[9], date))
+    return bad_field = "date", false;
+  if (!decodeDouble(f[10], variation))
+    return bad_field = "magnetic_variation", false;
+  if (f[12].size() > 1)
+    return bad_field = "mode", false;
+  if (f[12].size() == 1)
+    rmc.mode = f[12].front();
+  if (speed_knots)
+    rmc.speed_mps = *speed_knots * kMetresPerSecondPerKnot;
+  if (variation)
+    rmc.magnetic_variation_deg = f[11] == "W" ? -*variation : *variation;
+  if (date && rmc.time_of_day)
+    rmc.time = core::UtcTime{*date} + *rmc.time_of_day;
   return true;
 }
 
 bool decodeGga(const Fields& f, GgaData& gga, std::string_view& bad_field) {
   std::optional<int> quality;
-  if (!decodeTimeOfDay(f[1], gga.time_of_day)) return bad_field = "time", false;
-  if (!decodeCoordinate(f[2], f[3], 90, gga.latitude_deg)) return bad_field = "lat", false;
-  if (!decodeCoordinate(f[4], f[5], 180, gga.longitude_deg)) return bad_field = "lon", false;
+  if (!decodeTimeOfDay(f[1], gga.time_of_day))
+    return bad_field = "time", false;
+  if (!decodeCoordinate(f[2], f[3], 90, gga.latitude_deg))
+    return bad_field = "lat", false;
+  if (!decodeCoordinate(f[4], f[5], 180, gga.longitude_deg))
+    return bad_field = "lon", false;
   if (gga.latitude_deg.has_value() != gga.longitude_deg.has_value()) {
     return bad_field = "position", false;
   }
   if (!decodeInt(f[6], quality) || (quality && (*quality < 0 || *quality > 9))) {
     return bad_field = "quality", false;
   }
-  if (!decodeInt(f[7], gga.satellites)) return bad_field = "satellites", false;
-  if (!decodeDouble(f[8], gga.hdop)) return bad_field = "hdop", false;
-  if (!decodeDouble(f[9], gga.altitude_m)) return bad_field = "altitude", false;
-  if (!decodeDouble(f[11], gga.geoid_separation_m)) return bad_field = "geoid_separation", false;
-  if (!decodeDouble(f[13], gga.dgps_age_s)) return bad_field = "dgps_age", false;
+  if (!decodeInt(f[7], gga.satellites))
+    return bad_field = "satellites", false;
+  if (!decodeDouble(f[8], gga.hdop))
+    return bad_field = "hdop", false;
+  if (!decodeDouble(f[9], gga.altitude_m))
+    return bad_field = "altitude", false;
+  if (!decodeDouble(f[11], gga.geoid_separation_m))
+    return bad_field = "geoid_separation", false;
+  if (!decodeDouble(f[13], gga.dgps_age_s))
+    return bad_field = "dgps_age", false;
   gga.quality = quality.value_or(0);
   return true;
 }
@@ -279,7 +335,8 @@ NmeaParser::NmeaParser(Handler handler, const NmeaParserOptions& options)
 
 Sentence NmeaParser::parseLine(std::string_view line) {
   // Trailing blanks are transport noise, not part of the sentence.
-  while (!line.empty() && line.back() == ' ') line.remove_suffix(1);
+  while (!line.empty() && line.back() == ' ')
+    line.remove_suffix(1);
   if (line.empty() || (line.front() != '$' && line.front() != '!')) {
     return rejected(line, RejectReason::kGarbage);
   }
@@ -290,15 +347,18 @@ Sentence NmeaParser::parseLine(std::string_view line) {
   const std::size_t checksum_end = star == std::string_view::npos ? 0 : star;
   for (std::size_t i = 1; i < line.size(); ++i) {
     const auto c = static_cast<unsigned char>(line[i]);
-    if (c < 0x20 || c > 0x7e) return rejected(line, RejectReason::kNonPrintable);
-    if (i < checksum_end) checksum ^= c;
+    if (c < 0x20 || c > 0x7e)
+      return rejected(line, RejectReason::kNonPrintable);
+    if (i < checksum_end)
+      checksum ^= c;
   }
   if (star == std::string_view::npos || star + 3 != line.size()) {
     return rejected(line, RejectReason::kNoChecksum);
   }
   const int high = hexValue(line[star + 1]);
   const int low = hexValue(line[star + 2]);
-  if (high < 0 || low < 0) return rejected(line, RejectReason::kNoChecksum);
+  if (high < 0 || low < 0)
+    return rejected(line, RejectReason::kNoChecksum);
   if (checksum != static_cast<unsigned char>(high * 16 + low)) {
     return rejected(line, RejectReason::kBadChecksum);
   }
@@ -320,7 +380,8 @@ Sentence NmeaParser::parseLine(std::string_view line) {
   // '!' starts encapsulated (AIS) sentences; and since the start character is outside the
   // checksum, a '$' turned into '!' by line noise must not pass as a fix.
   std::string_view bad_field;
-  if (line.front() != '$') return sentence;
+  if (line.front() != '$')
+    return sentence;
   if (sentence.type == "RMC") {
     if (!decodeRmc(fields, sentence.rmc, bad_field)) {
       return rejected(line, RejectReason::kMalformed, bad_field);
@@ -353,7 +414,8 @@ void NmeaParser::emit(const Sentence& sentence) {
       ++stats_.rejected[static_cast<std::size_t>(sentence.reason)];
       break;
   }
-  if (handler_) handler_(sentence);
+  if (handler_)
+    handler_(sentence);
 }
 
 void NmeaParser::overlong(std::string_view line) {
@@ -373,7 +435,8 @@ void NmeaParser::processLine(std::string_view line) {
     return;
   }
   // Blank lines (the LF of a CR/LF pair, keep-alives) are not data.
-  if (line.find_first_not_of(' ') == std::string_view::npos) return;
+  if (line.find_first_not_of(' ') == std::string_view::npos)
+    return;
   ++stats_.lines;
   if (comment_lines_ && line.front() == '#') {
     ++stats_.comments;
@@ -403,10 +466,12 @@ void NmeaParser::feed(std::string_view bytes) {
   std::size_t pos = 0;
   while (pos < bytes.size()) {
     std::size_t end = pos;
-    while (end < bytes.size() && bytes[end] != '\n' && bytes[end] != '\r') ++end;
+    while (end < bytes.size() && bytes[end] != '\n' && bytes[end] != '\r')
+      ++end;
     if (end == bytes.size()) {
       // No terminator yet: keep the partial line, bounded by the maximum length.
-      if (discarding_) return;
+      if (discarding_)
+        return;
       pending_.append(bytes.substr(pos));
       if (pending_.size() > max_line_length_) {
         overlong(pending_);
@@ -429,14 +494,16 @@ void NmeaParser::feed(std::string_view bytes) {
 }
 
 void NmeaParser::flush() {
-  if (!pending_.empty()) processLine(pending_);
+  if (!pending_.empty())
+    processLine(pending_);
   pending_.clear();
   discarding_ = false;
 }
 
 unsigned char nmeaChecksum(std::string_view body) {
   unsigned char checksum = 0;
-  for (char c : body) checksum ^= static_cast<unsigned char>(c);
+  for (char c : body)
+    checksum ^= static_cast<unsigned char>(c);
   return checksum;
 }
 

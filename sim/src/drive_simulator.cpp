@@ -164,11 +164,11 @@ std::string DriveSimulator::nmea() const {
     std::snprintf(numbers, sizeof numbers, "%.3f,%.2f",
                   options_.speed_mps * kKnotsPerMetrePerSecond,
                   gps::bearingDegrees(pose.unit_east, pose.unit_north));
-    out += gps::withChecksum(options_.talker + "RMC," + timeText(t) + ",A," + lat + "," + lon + "," +
-                        numbers + "," + dateText(t) + ",,,R") +
+    out += gps::withChecksum(options_.talker + "RMC," + timeText(t) + ",A," + lat + "," + lon +
+                             "," + numbers + "," + dateText(t) + ",,,R") +
            "\r\n";
     out += gps::withChecksum(options_.talker + "GGA," + timeText(t) + "," + lat + "," + lon +
-                        ",4,14,0.7,285.000,M,-33.000,M,1.0,0001") +
+                             ",4,14,0.7,285.000,M,-33.000,M,1.0,0001") +
            "\r\n";
   }
   return out;

@@ -21,8 +21,8 @@ struct ImagingLocation {
   std::string id;
   double latitude_deg = 0;
   double longitude_deg = 0;
-  std::optional<double> heading_deg;      // direction of travel required, degrees true
-  std::vector<std::string> metadata;      // one value per LocationMap::metadataColumns()
+  std::optional<double> heading_deg;  // direction of travel required, degrees true
+  std::vector<std::string> metadata;  // one value per LocationMap::metadataColumns()
 };
 
 class LocationMap {

@@ -19,22 +19,22 @@
 namespace fieldrig::gps {
 
 enum class RejectReason : std::uint8_t {
-  kGarbage,          // bytes that are not a sentence (no '$'/'!' start), e.g. line noise
-  kNoChecksum,       // no "*hh" at the end: truncated, or sent without checksum
-  kBadChecksum,      // checksum does not match the payload
-  kTooLong,          // longer than the maximum line length before any terminator
-  kNonPrintable,     // control or 8-bit bytes inside the sentence
-  kMalformed,        // intact checksum but a field of RMC/GGA cannot be decoded
+  kGarbage,       // bytes that are not a sentence (no '$'/'!' start), e.g. line noise
+  kNoChecksum,    // no "*hh" at the end: truncated, or sent without checksum
+  kBadChecksum,   // checksum does not match the payload
+  kTooLong,       // longer than the maximum line length before any terminator
+  kNonPrintable,  // control or 8-bit bytes inside the sentence
+  kMalformed,     // intact checksum but a field of RMC/GGA cannot be decoded
   kCount_,
 };
 inline constexpr std::size_t kRejectReasonCount = static_cast<std::size_t>(RejectReason::kCount_);
 std::string_view toString(RejectReason reason);
 
 struct RmcData {
-  std::optional<core::UtcTime> time;          // date and time when both are present
+  std::optional<core::UtcTime> time;  // date and time when both are present
   std::optional<core::Nanoseconds> time_of_day;
-  bool status_active = false;                 // status 'A'
-  char mode = 0;                              // NMEA 2.3 mode indicator (A, D, E, N, F, R…), 0 if absent
+  bool status_active = false;  // status 'A'
+  char mode = 0;               // NMEA 2.3 mode indicator (A, D, E, N, F, R…), 0 if absent
   std::optional<double> latitude_deg;
   std::optional<double> longitude_deg;
   std::optional<double> speed_mps;
@@ -52,7 +52,7 @@ struct GgaData {
   int quality = 0;  // 0 = invalid, 1 GPS, 2 DGPS, 4 RTK fixed, 5 RTK float…
   std::optional<int> satellites;
   std::optional<double> hdop;
-  std::optional<double> altitude_m;            // above mean sea level
+  std::optional<double> altitude_m;  // above mean sea level
   std::optional<double> geoid_separation_m;
   std::optional<double> dgps_age_s;
 
@@ -75,12 +75,12 @@ struct Sentence {
 };
 
 struct NmeaStats {
-  std::uint64_t lines = 0;       // non-blank physical lines seen (run-together sentences: one line)
-  std::uint64_t comments = 0;    // '#' lines, when NmeaParserOptions::comment_lines is on
-  std::uint64_t sentences = 0;   // with a correct checksum
+  std::uint64_t lines = 0;      // non-blank physical lines seen (run-together sentences: one line)
+  std::uint64_t comments = 0;   // '#' lines, when NmeaParserOptions::comment_lines is on
+  std::uint64_t sentences = 0;  // with a correct checksum
   std::uint64_t rmc = 0;
   std::uint64_t gga = 0;
-  std::uint64_t other = 0;       // other sentence types with a correct checksum
+  std::uint64_t other = 0;  // other sentence types with a correct checksum
   std::array<std::uint64_t, kRejectReasonCount> rejected{};
 
   std::uint64_t rejectedTotal() const;
@@ -125,8 +125,8 @@ class NmeaParser {
   Handler handler_;
   std::size_t max_line_length_;
   bool comment_lines_ = false;
-  std::string pending_;         // a partial line carried over between chunks
-  bool discarding_ = false;     // inside an over-long line, dropping bytes until its end
+  std::string pending_;      // a partial line carried over between chunks
+  bool discarding_ = false;  // inside an over-long line, dropping bytes until its end
   NmeaStats stats_;
 };
 
