@@ -8,8 +8,17 @@ constexpr auto kDay = std::chrono::days{1};
 FixAssembler::FixAssembler(std::chrono::sys_days fallback_date) : fallback_date_(fallback_date) {}
 
 std::optional<core::UtcTime> FixAssembler::dateTimeFor(core::Nanoseconds time_of_day) {
-  if (!last_rmc_time_)
-    return core::UtcTime{fallback_date_} + time_of_day;
+  if (!last_rmc_time_) {
+    // No date from any RMC: a time of day far below the previous one is the next day (GGA-only
+    // receivers cross 00:00 UTC in the evening of the Americas' working day).
+    core::UtcTime time = core::UtcTime{fallback_date_} + time_of_day;
+    if (last_dateless_time_ && *last_dateless_time_ - time > std::chrono::hours{12}) {
+      fallback_date_ += kDay;
+      time += kDay;
+    }
+    last_dateless_time_ = time;
+    return time;
+  }
   // The GGA belongs to the day whose instant is nearest the last RMC's: this handles a GGA just
   // after midnight following an RMC of the previous day, and the reverse.
   const auto rmc_day = std::chrono::floor<std::chrono::days>(*last_rmc_time_);

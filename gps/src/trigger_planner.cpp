@@ -25,6 +25,10 @@ constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
 constexpr std::size_t kMinFitSamples = 3;
 // How far back along the track a location passed without a plan is still reported missed.
 constexpr double kMaxMissedSearchM = 30.0;
+// Fixes this far back in time are duplicates or stragglers; further back is a jump in time.
+constexpr double kMaxBackwardStepS = 2.0;
+// Below this the speed is noise around a standstill: no direction, no crossing time.
+constexpr double kMinPlanningSpeedMps = 0.01;
 constexpr core::Nanoseconds kDecisionTime = std::chrono::microseconds{1};
 
 struct Target {
@@ -290,8 +294,23 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
   State& s = *state_;
   ++s.stats.fixes;
   if (s.last_fix_time && fix.time <= *s.last_fix_time) {
-    ++s.stats.fixes_out_of_order;
-    return;
+    if (fix.time == *s.last_fix_time && !fix.valid) {
+      // The epoch's other sentence vetoes it (RMC status V or GGA quality 0 after a valid
+      // partner): what was planned from its first half must not fire.
+      ++s.stats.fixes_invalid;
+      s.restartTrack();
+      return;
+    }
+    if (*s.last_fix_time - fix.time <= core::fromSeconds(kMaxBackwardStepS)) {
+      ++s.stats.fixes_out_of_order;
+      return;
+    }
+    // A jump back in time (a receiver glitch with a future date before, a day boundary the
+    // date could not follow): start over rather than wait for time to catch up.
+    ++s.stats.time_jumps;
+    s.restartTrack();
+    s.origin = fix.time;
+    s.last_planned_position.reset();
   }
   s.last_fix_time = fix.time;
   if (!s.origin)
@@ -310,13 +329,12 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
          t - s.samples.front().t > s.options.fit_window_s + 1e-6) {
     s.samples.pop_front();
   }
-  s.rearm(position);
   s.fitAdaptively();
   if (!s.track) {
     s.plans.clear();
     return;
   }
-  if (s.track->speed < s.options.min_speed_mps) {
+  if (s.track->speed < std::max(s.options.min_speed_mps, kMinPlanningSpeedMps)) {
     ++s.stats.fixes_too_slow;
     s.plans.clear();
     return;
@@ -332,6 +350,9 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
   }
   s.plan(now, unplanned_distance);
   s.last_planned_position = EnuPoint{s.track->east, s.track->north};
+  // Re-armed only after planning, so that a location fired just before a gap is not taken for
+  // one passed during it.
+  s.rearm(position);
 }
 
 std::optional<core::UtcTime> TriggerPlanner::nextTriggerTime() const {
@@ -351,13 +372,8 @@ std::vector<core::TriggerEvent> TriggerPlanner::collectDue(core::UtcTime now) {
   std::vector<core::TriggerEvent> events;
   if (s.plans.empty())
     return events;
-  if (now - *s.last_fix_time > core::fromSeconds(s.options.max_fix_age_s)) {
-    // The plan rests on a fix too old to extrapolate from: the receiver stalled.
-    s.stats.stale_plans_dropped += s.plans.size();
-    s.plans.clear();
-    return events;
-  }
   const core::Nanoseconds min_interval = core::fromSeconds(s.options.min_trigger_interval_s);
+  const core::Nanoseconds max_fix_age = core::fromSeconds(s.options.max_fix_age_s);
   std::size_t done = 0;
   for (; done < s.plans.size(); ++done) {
     Plan& p = s.plans[done];
@@ -367,6 +383,12 @@ std::vector<core::TriggerEvent> TriggerPlanner::collectDue(core::UtcTime now) {
     }
     if (fire_at > now)
       break;
+    // Judged at the moment of firing, as the live timer would: a plan whose moment comes too
+    // long after the fix it rests on is extrapolation over a stalled receiver.
+    if (fire_at - *s.last_fix_time > max_fix_age) {
+      ++s.stats.stale_plans_dropped;
+      continue;
+    }
     if (fire_at != p.time) {
       p.status = core::TriggerStatus::kLate;
       ++s.stats.too_fast;

@@ -40,7 +40,8 @@ ReplaySummary replayTriggers(std::istream& nmea, const LocationMap& map,
           last_available = available;
         publish(available);
       },
-      NmeaParser::kDefaultMaxLineLength);
+      NmeaParserOptions{.max_line_length = NmeaParser::kDefaultMaxLineLength,
+                        .comment_lines = true});
 
   std::array<char, 65536> chunk{};
   while (nmea.read(chunk.data(), chunk.size()) || nmea.gcount() > 0) {

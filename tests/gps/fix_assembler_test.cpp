@@ -120,6 +120,16 @@ TEST(FixAssembler, GgaBeforeMidnightAfterANewDaysRmcBelongsToThePreviousDay) {
   EXPECT_EQ(late->time, sys_days{2026y / 12 / 31} + 23h + 59min + 59s + 900ms);
 }
 
+TEST(FixAssembler, GgaOnlyStreamRollsOverToTheNextDayAtMidnight) {
+  FixAssembler assembler(sys_days{std::chrono::year{2026} / 7 / 14});
+  const auto before = add(assembler, gga("235959.90"));
+  const auto after = add(assembler, gga("000000.00"));
+  ASSERT_TRUE(before && after);
+  EXPECT_FALSE(after->has_date);
+  EXPECT_EQ(after->time - before->time, 100ms);
+  EXPECT_EQ(after->time, sys_days{std::chrono::year{2026} / 7 / 15});
+}
+
 TEST(FixAssembler, RmcVoidVetoesTheEpoch) {
   for (const bool gga_first : {false, true}) {
     FixAssembler assembler;

@@ -189,10 +189,64 @@ TEST(TriggerPlannerTest, StoppedOrCreepingNeverTriggers) {
 TEST(TriggerPlannerTest, StaleFixesDoNotFireOnExtrapolation) {
   Field field;
   field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
-  TriggerPlanner planner(field.map(), {});
+  TriggerOptions options;
+  options.max_fix_age_s = 0.15;
+  TriggerPlanner planner(field.map(), options);
   Drive d;
-  d.present = [](int k) { return k < 60; };  // receiver stalls 1.5 s before the location
+  // The receiver stalls after fix 72 (0.6 m before A): the crossing is planned for 7.5 s, within
+  // the planning horizon, but 0.3 s after the last fix, more than a plan may rest on.
+  d.present = [](int k) { return k <= 72; };
   EXPECT_TRUE(drive(field, planner, d).empty());
+  EXPECT_EQ(planner.stats().stale_plans_dropped, 1u);
+}
+
+TEST(TriggerPlannerTest, StalenessIsJudgedAtTheMomentOfFiring) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);  // crossed at 7.5 s
+  TriggerPlanner planner(field.map(), {});
+  // Only fix 72 plans it; the next call comes long after (as replay does after a gap), but the
+  // trigger's own moment was 0.3 s after its fix, within max_fix_age_s: it fires, on time.
+  for (int k = 0; k <= 72; ++k) {
+    const core::UtcTime t = kStart + k * 100ms;
+    planner.addFix(field.fixAt(t, 0.0, -10.0 + 0.2 * k), t);
+  }
+  const auto events = planner.collectDue(kStart + 9s);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].status, core::TriggerStatus::kOnTime);
+  EXPECT_NEAR(core::toSeconds(events[0].time - kStart), 7.5, 1e-6);
+}
+
+TEST(TriggerPlannerTest, SameEpochVetoDropsThePlan) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);  // crossed at 7.5 s
+  TriggerPlanner planner(field.map(), {});
+  std::vector<core::TriggerEvent> events;
+  for (int k = 0; k <= 100; ++k) {
+    const core::UtcTime t = kStart + k * 100ms;
+    for (auto& e : planner.collectDue(t - 1ns))
+      events.push_back(e);
+    const core::GpsFix fix = field.fixAt(t, 0.0, -10.0 + 0.2 * k);
+    planner.addFix(fix, t);  // the RMC half, valid
+    if (k >= 70 && k <= 80) {
+      core::GpsFix vetoed = fix;  // the GGA half of the same epoch says quality 0
+      vetoed.valid = false;
+      planner.addFix(vetoed, t);
+    }
+    for (auto& e : planner.collectDue(t))
+      events.push_back(e);
+  }
+  EXPECT_TRUE(events.empty());
+}
+
+TEST(TriggerPlannerTest, RecoversFromAJumpBackInTime) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);
+  TriggerPlanner planner(field.map(), {});
+  // One glitched fix dated a day ahead, then the receiver goes on as before.
+  planner.addFix(field.fixAt(kStart + 24h, 0.0, -20.0), kStart + 24h);
+  const auto events = drive(field, planner, Drive{});
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(planner.stats().time_jumps, 1u);
 }
 
 TEST(TriggerPlannerTest, LocationPassedDuringAGapIsReportedMissed) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "fieldrig/gps/field_plan.h"
+#include "fieldrig/gps/fix_assembler.h"
 #include "fieldrig/gps/trigger_replay.h"
 
 namespace fieldrig::sim {
@@ -91,6 +92,49 @@ TEST(TriggerAccuracyTest, MeetsTheAccuracyTargetAtTwoMetresPerSecond) {
   EXPECT_LE(pooled.mean_abs_m, 0.010);
   EXPECT_LE(pooled.p95_abs_m, 0.020);
   EXPECT_LE(pooled.max_abs_m, 0.040);
+}
+
+TEST(TriggerAccuracyTest, ReplayBridgesAShortGapInTheCaptureOnTime) {
+  const auto map = gps::generateLocations(fieldPlan());
+  ASSERT_TRUE(map.ok());
+  const DriveSimulator drive(fieldPlan(), DriveOptions{});
+  // Drop the epochs from 0.25 s before to 0.35 s after the first location's crossing: the last
+  // fix before the gap plans the crossing < 0.35 s ahead, the next fix comes > 0.5 s after it.
+  // The live timer would fire on time; so must the replay.
+  const gps::ImagingLocation& first = map->locations().front();
+  std::string nmea;
+  std::istringstream all(drive.nmea());
+  gps::FixAssembler assembler;
+  core::UtcTime crossing{};
+  {
+    // The crossing is where the along-track error of firing changes sign.
+    core::UtcTime t = drive.start();
+    while (drive.alongTrackError(t, first.latitude_deg, first.longitude_deg) < 0) {
+      t += std::chrono::milliseconds{1};
+    }
+    crossing = t;
+  }
+  for (std::string line; std::getline(all, line);) {
+    const gps::Sentence s = gps::NmeaParser::parseLine(line.substr(0, line.size() - 1));
+    const auto fix = assembler.add(s, {});
+    if (fix && fix->time > crossing - std::chrono::milliseconds{250} &&
+        fix->time <= crossing + std::chrono::milliseconds{350}) {
+      continue;
+    }
+    nmea += line + "\n";
+  }
+  std::istringstream in(nmea);
+  std::vector<core::TriggerEvent> triggers;
+  const auto summary =
+      gps::replayTriggers(in, *map, gps::ReplayOptions{},
+                          {[&](const core::TriggerEvent& e) { triggers.push_back(e); }, {}});
+  const TriggerAccuracy accuracy = scoreTriggers(drive, *map, triggers);
+  EXPECT_EQ(accuracy.fired_once, map->size());
+  ASSERT_FALSE(triggers.empty());
+  EXPECT_EQ(triggers.front().location_id, first.id);
+  EXPECT_EQ(triggers.front().status, core::TriggerStatus::kOnTime);
+  EXPECT_LT(std::abs(accuracy.along_track_errors_m.front()), 0.04);
+  EXPECT_EQ(summary.planner.stale_plans_dropped, 0u);
 }
 
 TEST(TriggerAccuracyTest, EveryLocationFiresOnceAtOneAndThreeMetresPerSecond) {

@@ -28,8 +28,9 @@ class FixAssembler {
   std::optional<core::UtcTime> dateTimeFor(core::Nanoseconds time_of_day);
 
   std::chrono::sys_days fallback_date_;
-  std::optional<core::UtcTime> last_rmc_time_;  // date source for GGA
-  std::optional<core::GpsFix> epoch_;           // the epoch being assembled
+  std::optional<core::UtcTime> last_rmc_time_;       // date source for GGA
+  std::optional<core::UtcTime> last_dateless_time_;  // GGA time before any RMC: day rollover
+  std::optional<core::GpsFix> epoch_;                // the epoch being assembled
   bool epoch_has_rmc_ = false;
   bool epoch_has_gga_ = false;
   bool rmc_valid_ = false;

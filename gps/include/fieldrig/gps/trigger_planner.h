@@ -31,7 +31,7 @@ struct TriggerOptions {
   double cross_track_tolerance_m = 0.5;  // |lateral offset| allowed; rows are ≥ 0.76 m apart
   double heading_tolerance_deg = 60;     // course must be within ± this of a location's heading
   double min_speed_mps = 0.3;            // slower (or stopped) never triggers
-  double max_fix_age_s = 0.5;            // a plan older than this is stale and never fires
+  double max_fix_age_s = 0.5;            // a plan firing later than this after its fix never fires
   double max_fix_gap_s = 0.5;            // a longer gap between fixes restarts the track fit
   double min_trigger_interval_s = 0.25;  // the cameras' maximum rate
   double late_tolerance_m = 0.3;  // fire late if the crossing was missed by ≤ this; beyond: missed
@@ -58,6 +58,7 @@ struct TriggerStats {
   std::uint64_t fixes = 0;
   std::uint64_t fixes_invalid = 0;       // RMC status V or GGA quality 0
   std::uint64_t fixes_out_of_order = 0;  // not newer than the previous fix (duplicates of an epoch)
+  std::uint64_t time_jumps = 0;          // fix time went back by more than 2 s: track restarted
   std::uint64_t fixes_too_slow = 0;      // below min_speed_mps
   std::uint64_t track_restarts = 0;      // gaps and invalid fixes
   std::uint64_t triggers = 0;
