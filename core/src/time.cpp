@@ -17,6 +17,9 @@ std::string fractionText(std::int64_t nanos, int digits) {
 }
 
 bool parseInt(std::string_view text, int& out) {
+  // Digits only: from_chars would take a sign ("T-1:00:00").
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string_view::npos)
+    return false;
   auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
   return ec == std::errc() && ptr == text.data() + text.size();
 }

@@ -26,6 +26,8 @@ std::optional<core::UtcTime> LiveTriggerChain::gpsTimeAt(core::SteadyTime steady
 }
 
 void LiveTriggerChain::onSentence(const Sentence& sentence, const core::ReceptionStamp& received) {
+  if (stopped_)
+    return;
   const std::optional<core::GpsFix> fix = assembler_.add(sentence, received);
   if (!fix)
     return;
@@ -68,15 +70,19 @@ void LiveTriggerChain::armTimer() {
   }
   timer_.expires_at(core::SteadyTime{
       std::chrono::duration_cast<core::SteadyTime::duration>(next->time_since_epoch() + *offset_)});
-  timer_.async_wait([this](const boost::system::error_code& error) {
-    if (error)
-      return;  // cancelled: re-armed by a newer plan, or stopped
-    fireDue(std::chrono::steady_clock::now());
-    armTimer();
-  });
+  // A wait that completed just before the chain was stopped or destroyed may still be queued:
+  // it checks the token and the flag before touching the chain.
+  timer_.async_wait(
+      [this, alive = std::weak_ptr<char>(alive_)](const boost::system::error_code& error) {
+        if (error || alive.expired() || stopped_)
+          return;  // cancelled (re-armed by a newer plan), stopped, or destroyed
+        fireDue(std::chrono::steady_clock::now());
+        armTimer();
+      });
 }
 
 void LiveTriggerChain::stop() {
+  stopped_ = true;
   timer_.cancel();
 }
 

@@ -154,7 +154,10 @@ std::string DriveSimulator::nmea() const {
   std::normal_distribution<double> noise(0.0, options_.position_noise_m);
   const auto period = core::fromSeconds(1.0 / options_.rate_hz);
   std::string out;
-  for (core::UtcTime t = options_.start; t <= end(); t += period) {
+  for (core::UtcTime epoch = options_.start; epoch <= end(); epoch += period) {
+    // The sentences carry centiseconds: the position is the one at the time they state.
+    const core::UtcTime t =
+        std::chrono::floor<std::chrono::duration<std::int64_t, std::centi>>(epoch);
     const TruePose pose = poseAt(t);
     const gps::GeodeticPoint geo =
         frame_.toGeodetic(add(pose.position, noise(random), noise(random)));

@@ -32,6 +32,8 @@ TEST(TimeTest, RejectsMalformedIso) {
   EXPECT_FALSE(parseIso8601("2026-01-01T00:00:00"));
   EXPECT_FALSE(parseIso8601("2026-01-01T24:00:00Z"));
   EXPECT_FALSE(parseIso8601("2026-01-01T00:00:00.Z"));
+  EXPECT_FALSE(parseIso8601("2026-07-14T-1:00:00Z"));
+  EXPECT_FALSE(parseIso8601("2026-07-14T+1:00:00Z"));
 }
 
 TEST(TimeTest, TimeOfDay) {

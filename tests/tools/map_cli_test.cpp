@@ -387,6 +387,35 @@ TEST(MapCli, RecordRefusesAnIncompatibleExistingMap) {
   EXPECT_NE(run.err.find("map.csv:2: field 'lat': 95 is outside"), std::string::npos) << run.err;
 }
 
+TEST(MapCli, MarkAtAStandstillTakesTheHeadingFromTheTrackNotTheCourse) {
+  // Operators stop on the spot to mark it; the receiver then reports course 0.0 at speed 0.
+  const ScopedTempDir dir("map_cli_record_standstill");
+  const std::string fifo = dir / "gps.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  FieldrigProcess child({"map", "record", "--nmea", fifo, "--out", dir / "map.csv"}, dir.path());
+  const int writer = ::open(fifo.c_str(), O_WRONLY);
+  ASSERT_GE(writer, 0);
+  ASSERT_TRUE(child.waitForStderr("mark with Enter")) << child.err();
+  Track track;
+  std::string nmea;
+  for (int i = 0; i <= 30; ++i) {  // 3 s due south at 1 m/s, then 1 s standing
+    const double t = i / 10.0;
+    Epoch e = track.at(t, 0, -std::min(t, 2.0));
+    e.speed_mps = t < 2.0 ? 1.0 : 0.0;
+    e.course = t < 2.0 ? 180.0 : 0.0;
+    nmea += nmeaFor(e);
+  }
+  ASSERT_EQ(::write(writer, nmea.data(), nmea.size()), static_cast<ssize_t>(nmea.size()));
+  std::this_thread::sleep_for(300ms);
+  ASSERT_TRUE(child.sendInput("\n"));
+  ASSERT_TRUE(child.waitForStdoutLines(1)) << child.err();
+  ::close(writer);
+  ASSERT_EQ(child.waitExit(), 0) << child.err();
+  const std::vector<Json> marks = jsonLines(child.outLines());
+  ASSERT_EQ(marks.size(), 1u);
+  EXPECT_NEAR(marks[0]["heading_deg"].get<double>(), 180.0, 0.5);
+}
+
 TEST(MapCli, RecordFromAFifo) {
   const ScopedTempDir dir("map_cli_record_fifo");
   const std::string fifo = dir / "gps.fifo";

@@ -209,6 +209,30 @@ TEST(NmeaDecodeCli, CorruptLinesNeverYieldAnObject) {
   EXPECT_EQ(summary["rejected_total"], 7);
 }
 
+TEST(NmeaDecodeCli, TimesKeepTheReceiversPrecisionAndValidIsStatusA) {
+  // Millisecond times (hhmmss.sss) keep their third digit; status A with mode N (no fix) is
+  // still "valid": the contract's valid is the status field.
+  const std::string file_text =
+      withChecksum("GPRMC,235959.125,A,4000.12345678,N,08800.12345678,W,0.0,0.0,311226,,,N") +
+      "\r\n" +
+      withChecksum("GPGGA,235959.125,4000.12345678,N,08800.12345678,W,1,08,1.0,10.0,M,0,M,,") +
+      "\r\n" + withChecksum("GPRMC,000000.00,V,,,,,,,010127,,,N") + "\r\n";
+  const ScopedTempDir dir("nmea_decode_cli_precision");
+  const fs::path file = dir / "precision.nmea";
+  std::ofstream(file, std::ios::binary) << file_text;
+  const CliRun run = decode(file, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  Json summary;
+  const std::vector<Json> objects = checkContract(run, summary);
+  ASSERT_EQ(objects.size(), 3u);
+  EXPECT_EQ(objects[0]["time"], "2026-12-31T23:59:59.125Z");
+  EXPECT_EQ(objects[0]["valid"], true);
+  EXPECT_EQ(objects[1]["time_of_day"], "23:59:59.125");
+  EXPECT_EQ(objects[2]["time"], "2027-01-01T00:00:00.00Z");
+  EXPECT_EQ(objects[2]["valid"], false);
+  EXPECT_TRUE(objects[2]["lat"].is_null());
+}
+
 TEST(NmeaDecodeCli, MissingFileIsAnErrorNamingIt) {
   const std::string missing = "/nonexistent/fieldrig-no-such-file.nmea";
   const ScopedTempDir dir("nmea_decode_cli_missing");

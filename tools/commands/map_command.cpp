@@ -102,6 +102,8 @@ struct RecordOptions {
 // A mark needs a fix received this recently; older means the receiver or the link stalled and
 // the position no longer says where the tractor is.
 constexpr std::chrono::seconds kMaxFixAge{2};
+// Below this ground speed the receiver's course over ground is not a direction of travel.
+constexpr double kMinCourseSpeedMps = 0.3;  // as the trigger planner's minimum speed
 // Fixes kept for the heading fallback (bearing from an earlier fix).
 constexpr std::chrono::seconds kFixHistory{10};
 // Without an RMC course, the heading is the bearing from the latest earlier fix at least this
@@ -273,7 +275,10 @@ class MapRecorder {
     location.latitude_deg = fix.latitude_deg;
     location.longitude_deg = fix.longitude_deg;
     std::string heading_source = "none";
-    if (fix.course_deg && *fix.course_deg >= 0 && *fix.course_deg < 360) {
+    // At a standstill (operators stop on the spot to mark it) receivers report course 0 or a
+    // stale value: a course counts only while moving.
+    if (fix.course_deg && *fix.course_deg >= 0 && *fix.course_deg < 360 && fix.speed_mps &&
+        *fix.speed_mps >= kMinCourseSpeedMps) {
       location.heading_deg = fix.course_deg;
       heading_source = "course";
     } else if (auto bearing = trackBearing()) {
@@ -548,6 +553,20 @@ int runRecord(const RecordOptions& options) {
   std::unique_ptr<FileReplay> file;
   std::unique_ptr<StreamReplay> stream;
   std::string input_kind;
+  // Signals first: a mark sent while a FIFO open still waits for its writer must not kill us.
+  asio::signal_set signals(io, SIGUSR1, SIGINT, SIGTERM);
+  std::function<void(const boost::system::error_code&, int)> on_signal =
+      [&](const boost::system::error_code& error, int number) {
+        if (error)
+          return;
+        if (number == SIGUSR1) {
+          recorder.mark("sigusr1");
+          signals.async_wait(on_signal);
+        } else {
+          stop();
+        }
+      };
+  signals.async_wait(on_signal);
   if (type == std::filesystem::file_type::character) {
     input_kind = "serial device";
     gps::SerialOptions serial_options;
@@ -590,19 +609,6 @@ int runRecord(const RecordOptions& options) {
     file = std::make_unique<FileReplay>(io, std::move(in), options.realtime, recorder, stop);
   }
 
-  asio::signal_set signals(io, SIGUSR1, SIGINT, SIGTERM);
-  std::function<void(const boost::system::error_code&, int)> on_signal =
-      [&](const boost::system::error_code& error, int number) {
-        if (error)
-          return;
-        if (number == SIGUSR1) {
-          recorder.mark("sigusr1");
-          signals.async_wait(on_signal);
-        } else {
-          stop();
-        }
-      };
-  signals.async_wait(on_signal);
   StdinMarks marks(io, recorder);
   marks.start();
 

@@ -17,13 +17,24 @@ Json optionalNumber(const std::optional<double>& value) {
   return value ? Json(*value) : Json(nullptr);
 }
 
+// Digits after the seconds' point: at least 2 (NMEA's usual hhmmss.ss), more when the receiver
+// sent them (hhmmss.sss), so no precision is lost.
+int fractionDigits(core::Nanoseconds time_of_day) {
+  const std::int64_t nanos = time_of_day.count() % 1'000'000'000;
+  int digits = 2;
+  for (std::int64_t unit = 10'000'000; digits < 9 && nanos % unit != 0; unit /= 10)
+    ++digits;
+  return digits;
+}
+
 Json rmcJson(const gps::Sentence& s) {
   const gps::RmcData& rmc = s.rmc;
   Json out;
   out["sentence"] = "RMC";
   out["talker"] = s.talker;
-  out["time"] = rmc.time ? Json(core::formatIso8601(*rmc.time, 2)) : Json(nullptr);
-  out["valid"] = rmc.valid();
+  out["time"] = rmc.time ? Json(core::formatIso8601(*rmc.time, fractionDigits(*rmc.time_of_day)))
+                         : Json(nullptr);
+  out["valid"] = rmc.status_active;  // the contract: status A (mode N is in "mode")
   out["lat"] = optionalNumber(rmc.latitude_deg);
   out["lon"] = optionalNumber(rmc.longitude_deg);
   out["speed_mps"] = optionalNumber(rmc.speed_mps);
@@ -39,7 +50,9 @@ Json ggaJson(const gps::Sentence& s) {
   out["sentence"] = "GGA";
   out["talker"] = s.talker;
   out["time_of_day"] =
-      gga.time_of_day ? Json(core::formatTimeOfDay(*gga.time_of_day, 2)) : Json(nullptr);
+      gga.time_of_day
+          ? Json(core::formatTimeOfDay(*gga.time_of_day, fractionDigits(*gga.time_of_day)))
+          : Json(nullptr);
   out["lat"] = optionalNumber(gga.latitude_deg);
   out["lon"] = optionalNumber(gga.longitude_deg);
   out["quality"] = gga.quality;

@@ -130,7 +130,8 @@ int runTriggers(const TriggersArgs& args) {
     std::cerr << "fieldrig triggers: " << args.map_path << ": the map has no locations\n";
     return kExitBadInput;
   }
-  if (std::filesystem::is_character_file(args.nmea_path))
+  std::error_code type_error;  // an unreadable path is reported below as "cannot open"
+  if (std::filesystem::is_character_file(args.nmea_path, type_error))
     return runLive(args, *map);
   std::ifstream nmea(args.nmea_path, std::ios::binary);
   if (!nmea) {
@@ -170,7 +171,9 @@ void registerTriggersCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--heading-tolerance", p.heading_tolerance_deg, "degrees")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 180.0));
-  cmd->add_option("--min-speed", p.min_speed_mps, "m/s")->capture_default_str();
+  cmd->add_option("--min-speed", p.min_speed_mps, "m/s")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--min-interval", p.min_trigger_interval_s,
                   "minimum seconds between triggers (the cameras' rate)")
       ->capture_default_str()

@@ -14,6 +14,7 @@
 
 #include <deque>
 #include <functional>
+#include <memory>
 #include <optional>
 
 #include "fieldrig/core/trigger_event.h"
@@ -40,6 +41,7 @@ class LiveTriggerChain {
   // Feed every sentence as it arrives (SerialNmeaSource's handler).
   void onSentence(const Sentence& sentence, const core::ReceptionStamp& received);
 
+  // Ends triggering: the timer is cancelled and later sentences are ignored. Final.
   void stop();
 
   // GPS time corresponding to a steady-clock instant; nullopt before the first fix.
@@ -59,6 +61,8 @@ class LiveTriggerChain {
   TriggerPlanner planner_;
   std::deque<core::Nanoseconds> recent_offsets_;  // reception (steady) − fix time, per fix
   std::optional<core::Nanoseconds> offset_;       // steady − GPS time
+  bool stopped_ = false;
+  std::shared_ptr<char> alive_ = std::make_shared<char>();  // expires with the chain
 };
 
 }  // namespace fieldrig::gps
