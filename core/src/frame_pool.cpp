@@ -1,0 +1,99 @@
+#include "fieldrig/core/frame_pool.h"
+
+#include <stdexcept>
+#include <utility>
+
+namespace fieldrig::core {
+
+FramePool::FramePool(std::size_t buffer_count, std::size_t buffer_bytes)
+    : buffer_count_(buffer_count),
+      buffer_bytes_(buffer_bytes),
+      // boost's fixed-size queue indexes its nodes with 16 bits, hence the limit below.
+      free_(buffer_count),
+      available_(buffer_count) {
+  if (buffer_count == 0 || buffer_bytes == 0) {
+    throw std::invalid_argument("frame pool: buffer count and size must be positive");
+  }
+  if (buffer_count > 65534)
+    throw std::invalid_argument("frame pool: at most 65534 buffers");
+  memory_ = std::make_unique<std::uint8_t[]>(buffer_count * buffer_bytes);
+  references_ = std::make_unique<std::atomic<int>[]>(buffer_count);
+  for (std::size_t i = 0; i < buffer_count; ++i) {
+    references_[i].store(0, std::memory_order_relaxed);
+    free_.bounded_push(static_cast<std::uint32_t>(i));
+  }
+}
+
+FramePool::~FramePool() = default;
+
+FrameBuffer FramePool::acquire() {
+  std::uint32_t index = 0;
+  if (!free_.pop(index))
+    return {};
+  available_.fetch_sub(1, std::memory_order_relaxed);
+  references_[index].store(1, std::memory_order_relaxed);
+  return FrameBuffer(this, index);
+}
+
+void FramePool::addReference(std::uint32_t index) noexcept {
+  references_[index].fetch_add(1, std::memory_order_relaxed);
+}
+
+void FramePool::dropReference(std::uint32_t index) noexcept {
+  // acq_rel: the last holder's writes to the pixels happen-before the next acquirer's.
+  if (references_[index].fetch_sub(1, std::memory_order_acq_rel) == 1) {
+    available_.fetch_add(1, std::memory_order_relaxed);
+    free_.bounded_push(index);  // cannot fail: the queue holds every index at most once
+  }
+}
+
+FrameBuffer::FrameBuffer(const FrameBuffer& other) noexcept
+    : pool_(other.pool_), index_(other.index_) {
+  if (pool_)
+    pool_->addReference(index_);
+}
+
+FrameBuffer::FrameBuffer(FrameBuffer&& other) noexcept
+    : pool_(std::exchange(other.pool_, nullptr)), index_(other.index_) {}
+
+FrameBuffer& FrameBuffer::operator=(const FrameBuffer& other) noexcept {
+  if (this != &other) {
+    FrameBuffer copy(other);
+    *this = std::move(copy);
+  }
+  return *this;
+}
+
+FrameBuffer& FrameBuffer::operator=(FrameBuffer&& other) noexcept {
+  if (this != &other) {
+    reset();
+    pool_ = std::exchange(other.pool_, nullptr);
+    index_ = other.index_;
+  }
+  return *this;
+}
+
+FrameBuffer::~FrameBuffer() {
+  reset();
+}
+
+void FrameBuffer::reset() noexcept {
+  if (pool_)
+    std::exchange(pool_, nullptr)->dropReference(index_);
+}
+
+std::span<std::uint8_t> FrameBuffer::bytes() const {
+  if (!pool_)
+    return {};
+  return {pool_->data(index_), pool_->bufferBytes()};
+}
+
+std::size_t FrameBuffer::size() const {
+  return pool_ ? pool_->bufferBytes() : 0;
+}
+
+int FrameBuffer::useCount() const {
+  return pool_ ? pool_->references_[index_].load(std::memory_order_relaxed) : 0;
+}
+
+}  // namespace fieldrig::core
