@@ -1,0 +1,67 @@
+// The camera driver interface and its registry: one abstract Camera, drivers created by name
+// (the configuration names "sim", "aravis" or "dc1394"); a driver whose library is absent is not
+// built and so not registered (STYLE.md items 1 and 2).
+//
+// Thread contract: configure/start/stop/trigger are called by the camera's owner (the Rig).
+// trigger() never blocks: the GPS/trigger thread calls it. Frames are delivered on the driver's
+// own thread through the FrameSink, which must not block either (it only posts the frame).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fieldrig/core/frame.h"
+#include "fieldrig/core/result.h"
+
+namespace fieldrig::drivers {
+
+enum class TriggerSource { kSoftware, kExternal };
+
+struct CameraConfig {
+  std::string id;  // driver-specific: GUID for dc1394, device id for aravis, index for sim
+  core::PixelFormat format = core::PixelFormat::kBayerRG8;
+  std::uint32_t width = 1624;
+  std::uint32_t height = 1224;
+  double exposure_us = 2000;
+  double gain_db = 0;
+  std::optional<std::pair<double, double>> white_balance;  // (blue/U, red/V) gains
+  TriggerSource trigger = TriggerSource::kSoftware;
+  std::map<std::string, std::string> options;  // driver-specific extras
+};
+
+class Camera {
+ public:
+  using FrameSink = std::function<void(core::Frame&& frame)>;
+
+  virtual ~Camera() = default;
+  virtual std::string driverName() const = 0;
+  virtual core::Result<bool> configure(const CameraConfig& config) = 0;
+  // Frames are written into buffers from `pool` and handed to `sink` on the driver's thread.
+  virtual core::Result<bool> start(core::FramePool& pool, FrameSink sink) = 0;
+  virtual void stop() = 0;
+  // Software trigger for `trigger_id`; false if the camera cannot take it now (not started,
+  // external trigger, queue full). Never blocks.
+  virtual bool trigger(std::uint64_t trigger_id) = 0;
+};
+
+class CameraRegistry {
+ public:
+  using Factory = std::function<std::unique_ptr<Camera>()>;
+
+  // The registry with every driver this build has.
+  static CameraRegistry& instance();
+
+  void add(const std::string& name, Factory factory);
+  core::Result<std::unique_ptr<Camera>> create(const std::string& name) const;
+  std::vector<std::string> names() const;
+
+ private:
+  std::map<std::string, Factory> factories_;
+};
+
+}  // namespace fieldrig::drivers

@@ -1,0 +1,101 @@
+// The camera rig: owns the cameras (six Grasshoppers as three stereo heads in the field),
+// triggers them together and groups their frames into one FrameSet per trigger.
+//
+// Grouping is an explicit ordered merge (STYLE.md item 7): sets leave in trigger-id order, each
+// as soon as every camera delivered, or when its timeout expires, marked incomplete with the
+// missing cameras. The spread of the frames' device timestamps is measured and flagged above a
+// tolerance. Frames reach the rig thread through one lock-free SPSC queue per camera; triggers
+// through another, so trigger() never blocks the GPS/trigger thread.
+//
+// Thread contract: create/start/stop on the owner thread; trigger() on one thread (the
+// trigger thread); the SetSink runs on the rig's own thread and must not block.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fieldrig/core/frame.h"
+#include "fieldrig/core/spsc_queue.h"
+#include "fieldrig/drivers/camera.h"
+
+namespace fieldrig::drivers {
+
+struct RigOptions {
+  std::string driver = "sim";
+  std::vector<CameraConfig> cameras;             // in rig order: bottom L/R, middle L/R, top L/R
+  std::chrono::milliseconds frame_timeout{500};  // after the trigger, a set leaves incomplete
+  std::chrono::microseconds max_skew{125};       // the 1394b bus syncs to ~125 µs
+  std::size_t pool_sets = 16;                    // buffers for this many sets are allocated
+};
+
+struct RigStats {
+  std::uint64_t triggers = 0;
+  std::uint64_t triggers_refused = 0;  // a camera or the trigger queue could not take it
+  std::uint64_t sets = 0;
+  std::uint64_t incomplete_sets = 0;
+  std::uint64_t frames_missing = 0;  // no frame before the timeout
+  std::uint64_t frames_corrupt = 0;
+  std::uint64_t frames_dropped = 0;     // pool exhausted or rig queue full
+  std::uint64_t frames_unexpected = 0;  // for no pending trigger (late, or never triggered)
+  std::uint64_t skew_flagged = 0;
+  std::int64_t max_skew_ns = 0;
+};
+
+class Rig {
+ public:
+  using SetSink = std::function<void(core::FrameSet&& set)>;
+
+  // Creates and configures the cameras; errors name the camera and the problem.
+  static core::Result<std::unique_ptr<Rig>> create(const RigOptions& options,
+                                                   const CameraRegistry& registry);
+  ~Rig();
+  Rig(const Rig&) = delete;
+  Rig& operator=(const Rig&) = delete;
+
+  core::Result<bool> start(SetSink sink);
+  // Stops the cameras, emits what is pending (incomplete), joins the rig thread.
+  void stop();
+  // Triggers every camera for `trigger_id` (increasing). Never blocks; false if refused.
+  bool trigger(std::uint64_t trigger_id);
+
+  RigStats stats() const;  // a snapshot; thread-safe
+  std::size_t cameraCount() const { return cameras_.size(); }
+  core::FramePool& pool() { return *pool_; }
+
+ private:
+  struct Pending {
+    core::FrameSet set;
+    core::SteadyTime deadline{};
+    std::uint32_t arrived = 0;
+  };
+
+  Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras);
+  void run();
+  bool drain();
+  void emitReady(bool flush_all);
+  void emit(Pending& pending);
+
+  RigOptions options_;
+  std::vector<std::unique_ptr<Camera>> cameras_;
+  std::unique_ptr<core::FramePool> pool_;
+  std::vector<std::unique_ptr<core::SpscQueue<core::Frame>>> frame_queues_;  // one per camera
+  core::SpscQueue<std::pair<std::uint64_t, core::SteadyTime>> trigger_queue_{1024};
+  SetSink sink_;
+  std::map<std::uint64_t, Pending> pending_;  // rig thread only
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+
+  // Counters written by their owning thread, read by stats().
+  std::atomic<std::uint64_t> triggers_{0}, triggers_refused_{0}, frames_dropped_{0};
+  std::atomic<std::uint64_t> sets_{0}, incomplete_{0}, missing_{0}, corrupt_{0}, unexpected_{0},
+      skew_flagged_{0};
+  std::atomic<std::int64_t> max_skew_ns_{0};
+};
+
+}  // namespace fieldrig::drivers

@@ -1,0 +1,40 @@
+#include "fieldrig/drivers/camera.h"
+
+#include "fieldrig/drivers/sim_camera.h"
+
+namespace fieldrig::drivers {
+
+CameraRegistry& CameraRegistry::instance() {
+  // Built-in drivers are added here rather than by static registrars in their own files: a
+  // static library drops object files nothing refers to, registrars included.
+  static CameraRegistry registry = [] {
+    CameraRegistry r;
+    r.add("sim", [] { return std::make_unique<SimCamera>(); });
+    return r;
+  }();
+  return registry;
+}
+
+void CameraRegistry::add(const std::string& name, Factory factory) {
+  factories_[name] = std::move(factory);
+}
+
+core::Result<std::unique_ptr<Camera>> CameraRegistry::create(const std::string& name) const {
+  const auto it = factories_.find(name);
+  if (it == factories_.end()) {
+    std::string known;
+    for (const auto& [n, _] : factories_)
+      known += (known.empty() ? "" : ", ") + n;
+    return core::Error{"unknown camera driver '" + name + "' (this build has: " + known + ")"};
+  }
+  return it->second();
+}
+
+std::vector<std::string> CameraRegistry::names() const {
+  std::vector<std::string> names;
+  for (const auto& [name, _] : factories_)
+    names.push_back(name);
+  return names;
+}
+
+}  // namespace fieldrig::drivers

@@ -1,0 +1,201 @@
+// The Rig with six sim cameras: one FrameSet per trigger, in order, whole or marked incomplete
+// after the timeout, skew measured and flagged, buffers returned to the pool.
+#include "fieldrig/drivers/rig.h"
+
+#include <gtest/gtest.h>
+
+#include <mutex>
+#include <thread>
+
+#include "fieldrig/drivers/sim_camera.h"
+
+namespace fieldrig::drivers {
+namespace {
+
+using namespace std::chrono_literals;
+
+RigOptions sixCameras(std::uint32_t width = 64, std::uint32_t height = 48) {
+  RigOptions options;
+  for (int i = 0; i < 6; ++i) {
+    CameraConfig camera;
+    camera.id = std::to_string(i);
+    camera.width = width;
+    camera.height = height;
+    options.cameras.push_back(camera);
+  }
+  options.frame_timeout = 100ms;
+  return options;
+}
+
+// Collects sets on the rig thread; the test thread waits for a count.
+class Collector {
+ public:
+  Rig::SetSink sink() {
+    return [this](core::FrameSet&& set) {
+      std::lock_guard lock(mutex_);
+      sets_.push_back(std::move(set));
+    };
+  }
+  bool waitFor(std::size_t count, std::chrono::milliseconds timeout = 5s) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      {
+        std::lock_guard lock(mutex_);
+        if (sets_.size() >= count)
+          return true;
+      }
+      std::this_thread::sleep_for(1ms);
+    }
+    return false;
+  }
+  std::vector<core::FrameSet> take() {
+    std::lock_guard lock(mutex_);
+    return std::move(sets_);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<core::FrameSet> sets_;  // guarded by mutex_
+};
+
+bool patternMatches(const core::Frame& frame) {
+  const auto& m = frame.metadata;
+  const std::uint8_t* pixels = frame.buffer.bytes().data();
+  for (std::uint32_t y = 0; y < m.height; y += 7) {
+    for (std::uint32_t x = 0; x < m.width; x += 5) {
+      if (pixels[y * m.stride + x] != SimCamera::patternAt(m.camera, m.trigger_id, x, y)) {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+TEST(RigTest, OneWholeSetPerTriggerInOrder) {
+  RigOptions options = sixCameras();
+  options.pool_sets = 64;  // this test's collector keeps every set (and its buffers) to the end
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  Collector collector;
+  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
+  for (std::uint64_t id = 1; id <= 50; ++id) {
+    ASSERT_TRUE((*rig)->trigger(id));
+    std::this_thread::sleep_for(1ms);
+  }
+  ASSERT_TRUE(collector.waitFor(50));
+  (*rig)->stop();
+  const auto sets = collector.take();
+  ASSERT_EQ(sets.size(), 50u);
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    EXPECT_EQ(sets[i].trigger_id, i + 1);
+    for (std::uint32_t c = 0; c < 6; ++c) {
+      ASSERT_EQ(sets[i].frames[c].metadata.status, core::FrameStatus::kOk)
+          << "set " << i << " camera " << c;
+      EXPECT_EQ(sets[i].frames[c].metadata.camera, c);
+      EXPECT_EQ(sets[i].frames[c].metadata.trigger_id, i + 1);
+      EXPECT_TRUE(patternMatches(sets[i].frames[c])) << "set " << i << " camera " << c;
+    }
+  }
+  const RigStats stats = (*rig)->stats();
+  EXPECT_EQ(stats.sets, 50u);
+  EXPECT_EQ(stats.incomplete_sets, 0u);
+  EXPECT_EQ(stats.frames_dropped, 0u);
+}
+
+TEST(RigTest, MissingFrameYieldsAnIncompleteSetAfterTheTimeoutWithoutReordering) {
+  RigOptions options = sixCameras();
+  options.cameras[3].options["drop_every"] = "5";
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  Collector collector;
+  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
+  for (std::uint64_t id = 1; id <= 12; ++id)
+    ASSERT_TRUE((*rig)->trigger(id));
+  ASSERT_TRUE(collector.waitFor(12));
+  (*rig)->stop();
+  const auto sets = collector.take();
+  ASSERT_EQ(sets.size(), 12u);
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    const std::uint64_t id = i + 1;
+    EXPECT_EQ(sets[i].trigger_id, id);  // 5 and 10 waited for their timeout; 6-9 waited for 5
+    EXPECT_EQ(sets[i].complete(), id % 5 != 0);
+    if (id % 5 == 0) {
+      EXPECT_EQ(sets[i].frames[3].metadata.status, core::FrameStatus::kMissing);
+      EXPECT_FALSE(sets[i].frames[3].buffer);
+      EXPECT_EQ(sets[i].frames[2].metadata.status, core::FrameStatus::kOk);
+    }
+  }
+  EXPECT_EQ((*rig)->stats().frames_missing, 2u);
+  EXPECT_EQ((*rig)->stats().incomplete_sets, 2u);
+}
+
+TEST(RigTest, SkewAboveTheToleranceIsFlagged) {
+  RigOptions options = sixCameras();
+  options.cameras[5].options["clock_offset_us"] = "300";
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  Collector collector;
+  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
+  for (std::uint64_t id = 1; id <= 3; ++id)
+    ASSERT_TRUE((*rig)->trigger(id));
+  ASSERT_TRUE(collector.waitFor(3));
+  (*rig)->stop();
+  // 300 µs of clock offset, plus the few µs between the sim cameras' software triggers.
+  for (const auto& set : collector.take()) {
+    EXPECT_GE(set.skew_ns, 300'000);
+    EXPECT_LT(set.skew_ns, 300'000 + 1'000'000);
+  }
+  EXPECT_EQ((*rig)->stats().skew_flagged, 3u);
+  EXPECT_GE((*rig)->stats().max_skew_ns, 300'000);
+}
+
+TEST(RigTest, CorruptFramesAreDeliveredMarked) {
+  RigOptions options = sixCameras();
+  options.cameras[0].options["corrupt_every"] = "2";
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok());
+  Collector collector;
+  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
+  for (std::uint64_t id = 1; id <= 4; ++id)
+    ASSERT_TRUE((*rig)->trigger(id));
+  ASSERT_TRUE(collector.waitFor(4));
+  (*rig)->stop();
+  const auto sets = collector.take();
+  EXPECT_EQ(sets[1].frames[0].metadata.status, core::FrameStatus::kCorrupt);
+  EXPECT_TRUE(sets[1].frames[0].buffer);  // the pixels are kept for inspection
+  EXPECT_FALSE(sets[1].complete());
+  EXPECT_TRUE(sets[2].complete());
+  EXPECT_EQ((*rig)->stats().frames_corrupt, 2u);
+}
+
+TEST(RigTest, BuffersReturnToThePoolWhenConsumersLetGo) {
+  auto rig = Rig::create(sixCameras(), CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok());
+  Collector collector;
+  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
+  for (std::uint64_t id = 1; id <= 5; ++id)
+    ASSERT_TRUE((*rig)->trigger(id));
+  ASSERT_TRUE(collector.waitFor(5));
+  (*rig)->stop();
+  auto sets = collector.take();
+  EXPECT_EQ((*rig)->pool().available(), (*rig)->pool().capacity() - 30);
+  sets.clear();
+  EXPECT_EQ((*rig)->pool().available(), (*rig)->pool().capacity());
+}
+
+TEST(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
+  RigOptions options = sixCameras();
+  options.cameras[4].id = "left";
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_FALSE(rig.ok());
+  EXPECT_NE(rig.error().message.find("rig camera 4"), std::string::npos) << rig.error().message;
+  options = sixCameras();
+  options.driver = "gige";
+  rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_FALSE(rig.ok());
+  EXPECT_NE(rig.error().message.find("unknown camera driver 'gige'"), std::string::npos);
+  EXPECT_NE(rig.error().message.find("sim"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace fieldrig::drivers
