@@ -33,9 +33,11 @@ class FieldrigProcess {
  public:
   using Milliseconds = std::chrono::milliseconds;
 
-  FieldrigProcess(const std::vector<std::string>& args, const std::filesystem::path& work_dir)
+  // `program` is the fieldrig binary unless a test runs a helper program of its own.
+  FieldrigProcess(const std::vector<std::string>& args, const std::filesystem::path& work_dir,
+                  const std::string& program = kFieldrigBinary)
       : out_path_(work_dir / "process.out"), err_path_(work_dir / "process.err") {
-    std::vector<std::string> argv_text{kFieldrigBinary};
+    std::vector<std::string> argv_text{program};
     argv_text.insert(argv_text.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (std::string& arg : argv_text)

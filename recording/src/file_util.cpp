@@ -1,0 +1,203 @@
+#include "file_util.h"
+
+#include <fcntl.h>
+#include <openssl/evp.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+namespace fieldrig::recording::detail {
+
+int writeFully(int fd, const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, bytes, size);
+    if (n < 0) {
+      if (errno == EINTR)
+        continue;
+      return errno;
+    }
+    if (n == 0)
+      return EIO;
+    bytes += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return 0;
+}
+
+int syncDirectory(const std::filesystem::path& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0)
+    return errno;
+  const int result = ::fsync(fd) == 0 ? 0 : errno;
+  ::close(fd);
+  return result;
+}
+
+std::optional<std::string> readWholeFile(const std::filesystem::path& path, std::string& error) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    error = path.string() + ": cannot open: " + std::strerror(errno);
+    return std::nullopt;
+  }
+  std::string content;
+  struct stat info {};
+  if (::fstat(fd, &info) == 0 && info.st_size > 0)
+    content.reserve(static_cast<std::size_t>(info.st_size));
+  std::array<char, 65536> buffer;
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer.data(), buffer.size());
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n < 0) {
+      error = path.string() + ": cannot read: " + std::strerror(errno);
+      ::close(fd);
+      return std::nullopt;
+    }
+    if (n == 0)
+      break;
+    content.append(buffer.data(), static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  return content;
+}
+
+std::string replaceFileAtomically(const std::filesystem::path& path, std::string_view text) {
+  const std::filesystem::path temp = path.string() + ".tmp";
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    return temp.string() + ": cannot create: " + std::strerror(errno);
+  int error = writeFully(fd, text.data(), text.size());
+  if (error == 0 && ::fsync(fd) != 0)
+    error = errno;
+  ::close(fd);
+  if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0)
+    error = errno;
+  if (error != 0) {
+    ::unlink(temp.c_str());
+    return path.string() + ": cannot write: " + std::strerror(error);
+  }
+  if (const int sync_error = syncDirectory(path.parent_path()); sync_error != 0)
+    return path.parent_path().string() + ": cannot sync: " + std::strerror(sync_error);
+  return {};
+}
+
+std::string pgmHeader(int width, int height) {
+  char text[48];
+  const int n = std::snprintf(text, sizeof text, "P5\n%d %d\n255\n", width, height);
+  return std::string(text, static_cast<std::size_t>(n));
+}
+
+std::optional<PgmHeader> parsePgmHeader(std::string_view data) {
+  if (data.size() < 2 || data[0] != 'P' || data[1] != '5')
+    return std::nullopt;
+  std::size_t pos = 2;
+  const auto is_space = [](char c) {
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
+  };
+  // Three decimal fields separated by whitespace or comments, then exactly one whitespace byte.
+  std::array<long long, 3> fields{};
+  for (long long& field : fields) {
+    for (;;) {
+      while (pos < data.size() && is_space(data[pos]))
+        ++pos;
+      if (pos < data.size() && data[pos] == '#') {
+        while (pos < data.size() && data[pos] != '\n')
+          ++pos;
+        continue;
+      }
+      break;
+    }
+    const std::size_t start = pos;
+    field = 0;
+    while (pos < data.size() && data[pos] >= '0' && data[pos] <= '9' && pos - start < 9)
+      field = field * 10 + (data[pos++] - '0');
+    if (pos == start)
+      return std::nullopt;
+  }
+  if (pos >= data.size() || !is_space(data[pos]))
+    return std::nullopt;
+  PgmHeader header;
+  header.width = static_cast<int>(fields[0]);
+  header.height = static_cast<int>(fields[1]);
+  header.max_value = static_cast<int>(fields[2]);
+  header.header_bytes = pos + 1;
+  return header;
+}
+
+std::uint32_t crc32(std::span<const std::uint8_t> bytes) {
+  uLong crc = ::crc32(0L, Z_NULL, 0);
+  // zlib takes a uInt length; frames are far below 4 GiB, but a span need not be.
+  while (!bytes.empty()) {
+    const std::size_t chunk = std::min<std::size_t>(bytes.size(), 1u << 30);
+    crc = ::crc32(crc, bytes.data(), static_cast<uInt>(chunk));
+    bytes = bytes.subspan(chunk);
+  }
+  return static_cast<std::uint32_t>(crc);
+}
+
+std::string sha256File(const std::filesystem::path& path, std::string& error) {
+  const std::optional<std::string> content = readWholeFile(path, error);
+  if (!content)
+    return {};
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context(EVP_MD_CTX_new(),
+                                                                  &EVP_MD_CTX_free);
+  std::array<unsigned char, EVP_MAX_MD_SIZE> digest{};
+  unsigned int length = 0;
+  if (!context || EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) != 1 ||
+      EVP_DigestUpdate(context.get(), content->data(), content->size()) != 1 ||
+      EVP_DigestFinal_ex(context.get(), digest.data(), &length) != 1) {
+    error = path.string() + ": SHA-256 failed";
+    return {};
+  }
+  std::string hex;
+  char pair[3];
+  for (unsigned int i = 0; i < length; ++i) {
+    std::snprintf(pair, sizeof pair, "%02x", digest[i]);
+    hex += pair;
+  }
+  return hex;
+}
+
+core::Result<IndexScan> scanIndex(std::string_view content, const std::filesystem::path& path) {
+  IndexScan scan;
+  std::uint64_t line_number = 0;
+  std::size_t pos = 0;
+  while (pos < content.size()) {
+    ++line_number;
+    const std::size_t end = content.find('\n', pos);
+    if (end == std::string_view::npos) {
+      scan.torn_line = TornLine{line_number, pos, content.size() - pos};
+      break;
+    }
+    std::string error;
+    std::optional<IndexedSet> set = fromIndexLine(content.substr(pos, end - pos), error);
+    if (!set)
+      return core::Error{path.string() + ":" + std::to_string(line_number) + ": " + error};
+    if (!scan.sets.empty() && set->set_index <= scan.sets.back().set_index) {
+      return core::Error{path.string() + ":" + std::to_string(line_number) + ": set " +
+                         std::to_string(set->set_index) + " does not follow set " +
+                         std::to_string(scan.sets.back().set_index)};
+    }
+    scan.sets.push_back(std::move(*set));
+    pos = end + 1;
+    scan.whole_bytes = pos;
+  }
+  return scan;
+}
+
+std::string lineOf(std::string_view text, std::size_t byte) {
+  const std::size_t end = std::min(byte, text.size());
+  std::size_t line = 1;
+  for (std::size_t i = 0; i + 1 < end; ++i)
+    line += text[i] == '\n' ? 1 : 0;
+  return std::to_string(line);
+}
+
+}  // namespace fieldrig::recording::detail
