@@ -1,0 +1,126 @@
+// The Aravis driver: GigE Vision and USB3 Vision cameras through Aravis 0.8, the rig's upgrade
+// path from the 1394b Grasshoppers. Built only when pkg-config finds aravis-0.8; Aravis' own
+// headers stay inside drivers/aravis (this header names none of its types).
+//
+// CameraConfig::id is what arv_camera_new takes: a device id ("Basler-21234567"), an IP address
+// ("192.168.1.20", "127.0.0.1" for arv-fake-gv-camera on the loopback) or "Fake_N", which also
+// enables Aravis' in-process fake interface (tests and demos without a network).
+//
+// CameraConfig::options:
+//   camera_index=N        the rig index written into each frame's metadata (default 0)
+//   offset_x=X offset_y=Y the ROI's origin on the sensor (default 0, 0)
+//   trigger_line=LineK    the TriggerSource for TriggerSource::kExternal (default Line0)
+//   buffers=N             Aravis stream buffers allocated at start (default 8)
+//   genicam_pixel_format=NAME  the PixelFormat entry to request when the camera names the 8-bit
+//                         format differently from fieldrig's GenICam name; frames keep `format`
+//   packet_size=BYTES     GigE Vision stream packet size (default: the camera's)
+//   packet_resend=never|always  GigE Vision packet resend requests (default: Aravis' default)
+//
+// Triggers and frames: trigger() only queues the id (lock-free) and wakes the driver's trigger
+// thread, which issues the software trigger (a GVCP register write, a network round trip). Frames
+// are matched to issued triggers in order; the camera's frame id tells how many frames it sent
+// that never arrived, and those triggers are counted lost rather than shifting the ids of later
+// frames. Frames that arrive with no trigger outstanding (a free-running camera) are returned to
+// the stream uncounted as frames and counted as unsolicited. With an external trigger, trigger()
+// refuses (false) and frames are numbered 1, 2, … in arrival order, gaps included.
+//
+// Thread contract: configure/start/stop/stats on the owner thread; trigger() on one thread (the
+// trigger thread), never blocks. The FrameSink runs on Aravis' stream thread.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <thread>
+
+#include "fieldrig/core/spsc_queue.h"
+#include "fieldrig/drivers/camera.h"
+
+namespace fieldrig::drivers {
+
+// What went wrong on the way, for the run summary and health. A snapshot.
+struct AravisStats {
+  std::uint64_t triggers_accepted = 0;  // trigger() returned true
+  std::uint64_t triggers_refused = 0;   // not started, external trigger, or queue full
+  std::uint64_t triggers_failed = 0;    // never sent (stop came first) or the command failed
+  std::uint64_t frames_delivered = 0;   // handed to the sink, whatever their status
+  std::uint64_t frames_corrupt = 0;     // delivered with status kCorrupt (sum of the reasons below)
+  std::uint64_t frames_dropped = 0;     // delivered as kDropped: the frame pool was empty
+  std::uint64_t frames_lost = 0;        // triggered, never delivered (frame-id gap, or stop)
+  std::uint64_t frames_unsolicited = 0;  // arrived with no trigger outstanding; not delivered
+  // Corrupt frames by Aravis buffer status.
+  std::uint64_t status_timeout = 0;
+  std::uint64_t status_missing_packets = 0;
+  std::uint64_t status_size_mismatch = 0;  // includes a payload smaller than the ROI
+  std::uint64_t status_other = 0;
+  // Aravis' own stream counters (arv_stream_get_statistics), as of the last stop() or now.
+  std::uint64_t stream_completed = 0;
+  std::uint64_t stream_failures = 0;
+  std::uint64_t stream_underruns = 0;  // a frame came with no free Aravis buffer
+};
+
+class AravisCamera final : public Camera {
+ public:
+  AravisCamera();
+  ~AravisCamera() override;
+  AravisCamera(const AravisCamera&) = delete;
+  AravisCamera& operator=(const AravisCamera&) = delete;
+
+  std::string driverName() const override { return "aravis"; }
+  core::Result<bool> configure(const CameraConfig& config) override;
+  core::Result<bool> start(core::FramePool& pool, FrameSink sink) override;
+  void stop() override;
+  bool trigger(std::uint64_t trigger_id) override;
+
+  AravisStats stats() const;
+
+ private:
+  struct Vendor;  // the Aravis objects; defined where arv.h is included
+
+  void runTriggers();
+  void issueTrigger(std::uint64_t trigger_id);
+  // Stream thread: one finished Aravis buffer to one Frame for the sink.
+  void deliver(const void* data, std::size_t size, int arv_status, std::uint64_t frame_id,
+               std::uint64_t device_timestamp_ns);
+  // Stream thread: the trigger id for the next frame, after `gap` - 1 frames that never came;
+  // false when none is outstanding.
+  bool matchTrigger(std::uint64_t gap, std::uint64_t& trigger_id);
+  std::uint64_t outstandingTriggers() const;  // owner thread, after the stream has stopped
+  friend struct AravisCallbacks;
+
+  // Issued trigger ids, in order, for the stream thread to match frames against. A slot of a
+  // trigger whose command failed holds kFailedTrigger. Written by the trigger thread, read by the
+  // stream thread; issued_ and consumed_ publish the positions.
+  static constexpr std::size_t kIssuedRing = 1024;
+  static constexpr std::uint64_t kFailedTrigger = ~std::uint64_t{0};
+
+  CameraConfig config_;
+  std::uint32_t camera_index_ = 0;
+  std::uint32_t offset_x_ = 0;
+  std::uint32_t offset_y_ = 0;
+  std::uint32_t buffer_count_ = 8;
+  std::unique_ptr<Vendor> vendor_;
+  core::FramePool* pool_ = nullptr;
+  FrameSink sink_;
+
+  core::SpscQueue<std::uint64_t> triggers_{256};  // trigger thread → trigger worker
+  std::atomic<std::uint32_t> wakeups_{0};         // bumped per trigger; the worker waits on it
+  std::atomic<bool> running_{false};
+  std::thread trigger_worker_;
+  std::unique_ptr<std::atomic<std::uint64_t>[]> issued_ids_;  // kIssuedRing slots
+  std::atomic<std::uint64_t> issued_{0};                      // slots written (trigger worker)
+  std::atomic<std::uint64_t> consumed_{0};  // slots matched or counted lost (stream thread)
+
+  // Stream thread only.
+  bool have_frame_id_ = false;
+  std::uint64_t last_frame_id_ = 0;
+  std::uint64_t external_count_ = 0;
+
+  // Counters, each written by one thread, read by stats().
+  std::atomic<std::uint64_t> accepted_{0}, refused_{0}, failed_{0}, delivered_{0}, corrupt_{0},
+      dropped_{0}, lost_{0}, unsolicited_{0}, timeout_{0}, missing_packets_{0}, size_mismatch_{0},
+      other_status_{0};
+  std::uint64_t stream_completed_ = 0, stream_failures_ = 0, stream_underruns_ = 0;  // owner
+};
+
+}  // namespace fieldrig::drivers
