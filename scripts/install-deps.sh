@@ -7,8 +7,14 @@ packages=(
   libboost-dev libboost-system-dev
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libgeographiclib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libssl-dev zlib1g-dev  # recording: SHA-256 of the location map (EVP), CRC-32 per frame
+  libdc1394-dev  # the dc1394 driver (IEEE-1394 IIDC cameras); optional: skipped when absent
+  libyaml-cpp-dev  # dc1394 tests read ROS camera1394 parameter files
   socat          # serial tests run through real pseudo-terminals
   clang libclang-rt-14-dev  # libFuzzer for the NMEA parser fuzz test
+  # The aravis driver and its tests (arv-fake-gv-camera-0.8); Debian's aravis-0.8.pc also
+  # needs libusb-1.0's .pc file, which libaravis-dev does not pull in.
+  libaravis-dev aravis-tools libusb-1.0-0-dev
 )
 
 missing=()

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   fieldrig::tools::registerMapCommand(app, exit_code);
   fieldrig::tools::registerTriggersCommand(app, exit_code);
   fieldrig::tools::registerSimCommand(app, exit_code);
+  fieldrig::tools::registerAcquireCommand(app, exit_code);
+  fieldrig::tools::registerSessionCommand(app, exit_code);
   CLI11_PARSE(app, argc, argv);
   return exit_code;
 }

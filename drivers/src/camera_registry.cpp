@@ -2,6 +2,13 @@
 
 #include "fieldrig/drivers/sim_camera.h"
 
+#ifdef FIELDRIG_HAVE_DC1394
+#include "fieldrig/drivers/dc1394/dc1394_camera.h"
+#endif
+#ifdef FIELDRIG_HAVE_ARAVIS
+#include "fieldrig/drivers/aravis/aravis_camera.h"
+#endif
+
 namespace fieldrig::drivers {
 
 CameraRegistry& CameraRegistry::instance() {
@@ -10,6 +17,12 @@ CameraRegistry& CameraRegistry::instance() {
   static CameraRegistry registry = [] {
     CameraRegistry r;
     r.add("sim", [] { return std::make_unique<SimCamera>(); });
+#ifdef FIELDRIG_HAVE_DC1394
+    r.add("dc1394", [] { return makeDc1394Camera(); });
+#endif
+#ifdef FIELDRIG_HAVE_ARAVIS
+    r.add("aravis", [] { return std::make_unique<AravisCamera>(); });
+#endif
     return r;
   }();
   return registry;

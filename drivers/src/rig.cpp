@@ -76,16 +76,17 @@ void Rig::stop() {
 }
 
 bool Rig::trigger(std::uint64_t trigger_id) {
-  if (!running_ || !trigger_queue_.tryPush({trigger_id, std::chrono::steady_clock::now()})) {
+  const core::SteadyTime issued = std::chrono::steady_clock::now();
+  if (!running_ || !trigger_queue_.tryPush({trigger_id, issued})) {
     triggers_refused_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
   triggers_.fetch_add(1, std::memory_order_relaxed);
   bool all = true;
   for (auto& camera : cameras_)
-    all = camera->trigger(trigger_id) && all;
-  if (!all)
-    triggers_refused_.fetch_add(1, std::memory_order_relaxed);
+    all = camera->triggerAt(trigger_id, issued) && all;
+  if (!all)  // the set still comes, its frames from the refusing cameras marked missing
+    camera_refusals_.fetch_add(1, std::memory_order_relaxed);
   return all;
 }
 
@@ -180,6 +181,7 @@ RigStats Rig::stats() const {
   RigStats s;
   s.triggers = triggers_.load();
   s.triggers_refused = triggers_refused_.load();
+  s.camera_triggers_refused = camera_refusals_.load();
   s.sets = sets_.load();
   s.incomplete_sets = incomplete_.load();
   s.frames_missing = missing_.load();

@@ -56,6 +56,10 @@ core::Result<bool> SimCamera::configure(const CameraConfig& config) {
   }
   config_ = config;
   camera_index_ = index;
+  row_template_.resize(config.width);
+  for (std::uint32_t x = 0; x < config.width; ++x) {
+    row_template_[x] = static_cast<std::uint8_t>(patternAt(0, 0, x, 0));
+  }
   drop_every_ = static_cast<std::uint64_t>(*drop);
   corrupt_every_ = static_cast<std::uint64_t>(*corrupt);
   delay_ = std::chrono::milliseconds{*delay};
@@ -86,9 +90,13 @@ void SimCamera::stop() {
 }
 
 bool SimCamera::trigger(std::uint64_t trigger_id) {
+  return triggerAt(trigger_id, std::chrono::steady_clock::now());
+}
+
+bool SimCamera::triggerAt(std::uint64_t trigger_id, core::SteadyTime issued) {
   if (!running_)
     return false;
-  if (!triggers_.tryPush({trigger_id, std::chrono::steady_clock::now()}))
+  if (!triggers_.tryPush({trigger_id, issued}))
     return false;
   wakeups_.fetch_add(1, std::memory_order_release);
   wakeups_.notify_one();
@@ -130,10 +138,14 @@ void SimCamera::produce(const PendingTrigger& pending) {
   if (!frame.buffer) {
     m.status = core::FrameStatus::kDropped;
   } else {
+    // Row y is the row template (x * 3) plus a per-row constant, in 8-bit wrap-around: the same
+    // values patternAt() gives, at memory speed (the sim must keep up with six 2 MP cameras).
     std::uint8_t* pixels = frame.buffer.bytes().data();
     for (std::uint32_t y = 0; y < m.height; ++y) {
+      const std::uint8_t base = patternAt(camera_index_, pending.id, 0, y);
+      std::uint8_t* row = pixels + std::size_t{y} * m.stride;
       for (std::uint32_t x = 0; x < m.width; ++x) {
-        pixels[std::size_t{y} * m.stride + x] = patternAt(camera_index_, pending.id, x, y);
+        row[x] = static_cast<std::uint8_t>(row_template_[x] + base);
       }
     }
     if (corrupt_every_ != 0 && pending.id % corrupt_every_ == 0) {

@@ -15,5 +15,7 @@ void registerNmeaCommand(CLI::App& app, int& exit_code);
 void registerMapCommand(CLI::App& app, int& exit_code);
 void registerTriggersCommand(CLI::App& app, int& exit_code);
 void registerSimCommand(CLI::App& app, int& exit_code);
+void registerAcquireCommand(CLI::App& app, int& exit_code);
+void registerSessionCommand(CLI::App& app, int& exit_code);
 
 }  // namespace fieldrig::tools

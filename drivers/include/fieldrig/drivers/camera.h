@@ -47,6 +47,12 @@ class Camera {
   // Software trigger for `trigger_id`; false if the camera cannot take it now (not started,
   // external trigger, queue full). Never blocks.
   virtual bool trigger(std::uint64_t trigger_id) = 0;
+  // The same, for a trigger the rig issued to all cameras at `issued` (one broadcast on a real
+  // bus). Drivers whose device stamps exposures themselves ignore the time.
+  virtual bool triggerAt(std::uint64_t trigger_id, core::SteadyTime issued) {
+    (void)issued;
+    return trigger(trigger_id);
+  }
 };
 
 class CameraRegistry {

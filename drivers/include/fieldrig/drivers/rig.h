@@ -36,7 +36,8 @@ struct RigOptions {
 
 struct RigStats {
   std::uint64_t triggers = 0;
-  std::uint64_t triggers_refused = 0;  // a camera or the trigger queue could not take it
+  std::uint64_t triggers_refused = 0;         // not taken at all: no set will come
+  std::uint64_t camera_triggers_refused = 0;  // a camera could not take it: its frame will miss
   std::uint64_t sets = 0;
   std::uint64_t incomplete_sets = 0;
   std::uint64_t frames_missing = 0;  // no frame before the timeout
@@ -67,6 +68,7 @@ class Rig {
   RigStats stats() const;  // a snapshot; thread-safe
   std::size_t cameraCount() const { return cameras_.size(); }
   core::FramePool& pool() { return *pool_; }
+  const core::FramePool& pool() const { return *pool_; }
 
  private:
   struct Pending {
@@ -92,7 +94,8 @@ class Rig {
   std::thread thread_;
 
   // Counters written by their owning thread, read by stats().
-  std::atomic<std::uint64_t> triggers_{0}, triggers_refused_{0}, frames_dropped_{0};
+  std::atomic<std::uint64_t> triggers_{0}, triggers_refused_{0}, camera_refusals_{0},
+      frames_dropped_{0};
   std::atomic<std::uint64_t> sets_{0}, incomplete_{0}, missing_{0}, corrupt_{0}, unexpected_{0},
       skew_flagged_{0};
   std::atomic<std::int64_t> max_skew_ns_{0};

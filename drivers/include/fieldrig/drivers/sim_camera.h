@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cstdint>
 #include <thread>
+#include <vector>
 
 #include "fieldrig/core/spsc_queue.h"
 #include "fieldrig/drivers/camera.h"
@@ -31,6 +32,9 @@ class SimCamera final : public Camera {
   core::Result<bool> start(core::FramePool& pool, FrameSink sink) override;
   void stop() override;
   bool trigger(std::uint64_t trigger_id) override;
+  // The sim's "exposure" happens at `issued` for every camera, as with a broadcast on the bus:
+  // the rig's skew then measures the sim's injected clock offsets, not thread scheduling.
+  bool triggerAt(std::uint64_t trigger_id, core::SteadyTime issued) override;
 
   // The pixel value the pattern puts at (x, y) of camera `camera_index`'s frame for a trigger.
   static std::uint8_t patternAt(std::uint32_t camera_index, std::uint64_t trigger_id,
@@ -56,7 +60,8 @@ class SimCamera final : public Camera {
   core::SpscQueue<PendingTrigger> triggers_{256};
   std::atomic<std::uint32_t> wakeups_{0};  // bumped per trigger; the worker waits on it
   std::atomic<bool> running_{false};
-  std::uint64_t sequence_ = 0;  // worker thread only
+  std::uint64_t sequence_ = 0;              // worker thread only
+  std::vector<std::uint8_t> row_template_;  // x * 3 for one row, built by configure()
   std::thread worker_;
 };
 

@@ -1,0 +1,92 @@
+// Acquisition: the rig's FrameSets go to the recorder first (never dropped) and to live
+// processing when it keeps up (skipped and counted when it does not).
+//
+//   rig thread ──► SpscQueue (sized to the pool: cannot overflow) ──► recorder thread ──► disk
+//             └──► SpscQueue (small) ──► processing thread (optional)
+//
+// The recording queue is sized far beyond the pool: when the disk falls behind, the pool runs
+// dry first and the cameras' frames are counted as dropped, in the open, while every set (if
+// only with missing frames) still reaches the recording.
+//
+// Thread contract: construct, start, trigger and stop from one owner thread (trigger() never
+// blocks); stats() from any thread.
+#pragma once
+
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fieldrig/core/frame.h"
+#include "fieldrig/core/spsc_queue.h"
+#include "fieldrig/drivers/rig.h"
+#include "fieldrig/recording/session_writer.h"
+
+namespace fieldrig::daemon {
+
+struct AcquisitionOptions {
+  drivers::RigOptions rig;
+  std::filesystem::path session_dir;
+  recording::SessionInfo session;
+  recording::WriterOptions writer;
+  std::vector<std::string> camera_names;  // one per camera; default bottom_left … top_right
+  std::size_t processing_queue_sets = 2;
+};
+
+struct AcquisitionStats {
+  drivers::RigStats rig;
+  std::uint64_t sets_recorded = 0;
+  std::uint64_t sets_lost = 0;  // never recorded: the recording queue was full
+  std::uint64_t sets_skipped_for_processing = 0;
+  std::uint64_t sets_processed = 0;
+  std::uint64_t bytes_written = 0;
+  bool recording_stopped = false;  // disk full or I/O error: see alarm
+  std::string alarm;
+};
+
+class Acquisition {
+ public:
+  using ProcessSet = std::function<void(const core::FrameSet& set)>;
+
+  // Opens the session and creates the rig; errors name what failed.
+  static core::Result<std::unique_ptr<Acquisition>> create(AcquisitionOptions options,
+                                                           const drivers::CameraRegistry& registry);
+  ~Acquisition();
+
+  // Starts the recorder (and processing, when given) and the rig.
+  core::Result<bool> start(ProcessSet process = {});
+  // Triggers the next set; its trigger id continues the session's numbering. Never blocks.
+  bool trigger();
+  // Waits (bounded) until every triggered set has left the rig and been recorded, then stops.
+  void finish(std::chrono::milliseconds timeout);
+
+  AcquisitionStats stats() const;
+  std::uint64_t triggered() const { return triggered_; }
+  std::size_t poolBytes() const;
+
+ private:
+  explicit Acquisition(AcquisitionOptions options);
+  void recordLoop();
+  void processLoop();
+
+  AcquisitionOptions options_;
+  std::unique_ptr<drivers::Rig> rig_;
+  recording::SessionWriter writer_;  // recorder thread only, once started
+  std::unique_ptr<core::SpscQueue<core::FrameSet>> to_recorder_;
+  std::unique_ptr<core::SpscQueue<core::FrameSet>> to_processing_;
+  ProcessSet process_;
+  std::uint64_t next_trigger_id_ = 1;
+  std::uint64_t triggered_ = 0;
+  std::atomic<bool> running_{false};
+  std::thread recorder_;
+  std::thread processor_;
+
+  std::atomic<std::uint64_t> recorded_{0}, lost_{0}, skipped_{0}, processed_{0}, bytes_{0};
+  std::atomic<bool> recording_stopped_{false};
+  std::string alarm_;  // written by the recorder thread before recording_stopped_ is set
+};
+
+}  // namespace fieldrig::daemon

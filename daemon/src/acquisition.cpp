@@ -1,0 +1,218 @@
+#include "fieldrig/daemon/acquisition.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+namespace fieldrig::daemon {
+namespace {
+
+constexpr auto kIdlePoll = std::chrono::microseconds{500};
+// Sets whose frames went missing hold no buffers, so the pool alone does not bound the queue:
+// room for this many sets (about 1 KB each, allocated at start) before one could be lost.
+constexpr std::size_t kRecorderQueueSets = 4096;
+
+const std::vector<std::string>& defaultCameraNames() {
+  static const std::vector<std::string> names = {"bottom_left",  "bottom_right", "middle_left",
+                                                 "middle_right", "top_left",     "top_right"};
+  return names;
+}
+
+recording::FrameStatus recordingStatus(core::FrameStatus status) {
+  switch (status) {
+    case core::FrameStatus::kOk:
+      return recording::FrameStatus::kOk;
+    case core::FrameStatus::kCorrupt:
+      return recording::FrameStatus::kCorrupt;
+    case core::FrameStatus::kDropped:
+      return recording::FrameStatus::kDropped;
+    case core::FrameStatus::kMissing:
+      break;
+  }
+  return recording::FrameStatus::kMissing;
+}
+
+std::string_view statusReason(core::FrameStatus status) {
+  switch (status) {
+    case core::FrameStatus::kOk:
+      return "";
+    case core::FrameStatus::kMissing:
+      return "no frame before the rig's timeout";
+    case core::FrameStatus::kCorrupt:
+      return "the driver marked the frame damaged";
+    case core::FrameStatus::kDropped:
+      return "no free buffer: the frame pool was exhausted";
+  }
+  return "";
+}
+
+}  // namespace
+
+core::Result<std::unique_ptr<Acquisition>> Acquisition::create(
+    AcquisitionOptions options, const drivers::CameraRegistry& registry) {
+  if (options.camera_names.empty()) {
+    for (std::size_t i = 0; i < options.rig.cameras.size(); ++i) {
+      options.camera_names.push_back(
+          i < defaultCameraNames().size() ? defaultCameraNames()[i] : "camera" + std::to_string(i));
+    }
+  }
+  if (options.camera_names.size() != options.rig.cameras.size()) {
+    return core::Error{"acquisition: " + std::to_string(options.camera_names.size()) +
+                       " camera names for " + std::to_string(options.rig.cameras.size()) +
+                       " cameras"};
+  }
+  auto rig = drivers::Rig::create(options.rig, registry);
+  if (!rig)
+    return rig.error();
+  std::unique_ptr<Acquisition> acquisition(new Acquisition(std::move(options)));
+  acquisition->rig_ = std::move(*rig);
+  auto opened =
+      acquisition->writer_.open(acquisition->options_.session_dir, acquisition->options_.session,
+                                acquisition->options_.writer);
+  if (!opened)
+    return opened.error();
+  acquisition->next_trigger_id_ = opened->next_set_index + 1;
+  return acquisition;
+}
+
+Acquisition::Acquisition(AcquisitionOptions options)
+    : options_(std::move(options)),
+      to_recorder_(std::make_unique<core::SpscQueue<core::FrameSet>>(
+          std::max(options_.rig.pool_sets + 1, kRecorderQueueSets))),
+      to_processing_(
+          std::make_unique<core::SpscQueue<core::FrameSet>>(options_.processing_queue_sets)) {}
+
+Acquisition::~Acquisition() {
+  if (running_)
+    finish(std::chrono::milliseconds{0});
+}
+
+core::Result<bool> Acquisition::start(ProcessSet process) {
+  process_ = std::move(process);
+  running_ = true;
+  recorder_ = std::thread([this] { recordLoop(); });
+  if (process_)
+    processor_ = std::thread([this] { processLoop(); });
+  auto started = rig_->start([this](core::FrameSet&& set) {
+    if (process_ && !to_processing_->tryPush(set)) {
+      skipped_.fetch_add(1, std::memory_order_relaxed);  // live processing only: it is recorded
+    }
+    if (!to_recorder_->tryPush(set)) {
+      // Only when the recorder is thousands of sets behind: counted, and said loudly.
+      lost_.fetch_add(1, std::memory_order_relaxed);
+      spdlog::error("acquisition: recording queue full, set {} lost", set.trigger_id);
+    }
+  });
+  if (!started) {
+    finish(std::chrono::milliseconds{0});
+    return started.error();
+  }
+  return true;
+}
+
+bool Acquisition::trigger() {
+  const bool accepted = rig_->trigger(next_trigger_id_++);
+  ++triggered_;
+  return accepted;
+}
+
+void Acquisition::finish(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline && !recording_stopped_ &&
+         recorded_.load() + lost_.load() + rig_->stats().triggers_refused < triggered_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds{1});
+  }
+  rig_->stop();  // emits what is still pending, incomplete
+  running_ = false;
+  if (recorder_.joinable())
+    recorder_.join();
+  if (processor_.joinable())
+    processor_.join();
+  writer_.close();
+}
+
+void Acquisition::recordLoop() {
+  recording::FrameSetRecord record;  // reused: its vectors and strings keep their capacity
+  core::FrameSet set;
+  while (true) {
+    if (!to_recorder_->tryPop(set)) {
+      if (!running_)
+        return;
+      std::this_thread::sleep_for(kIdlePoll);
+      continue;
+    }
+    if (writer_.stopped())
+      continue;  // drained, not written: the alarm has been raised
+    record.trigger_id = set.trigger_id;
+    record.complete = set.complete();
+    record.skew_us = static_cast<double>(set.skew_ns) / 1000.0;
+    record.trigger_time = core::UtcTime{std::chrono::duration_cast<core::Nanoseconds>(
+        std::chrono::system_clock::now().time_since_epoch())};
+    record.frames.resize(set.camera_count);
+    for (std::uint32_t c = 0; c < set.camera_count; ++c) {
+      const core::Frame& frame = set.frames[c];
+      recording::FrameView& view = record.frames[c];
+      view.camera_index = static_cast<int>(c);
+      view.camera_name = options_.camera_names[c];
+      view.width = static_cast<int>(frame.metadata.width);
+      view.height = static_cast<int>(frame.metadata.height);
+      view.stride = static_cast<int>(frame.metadata.stride);
+      view.pixel_format = frame.metadata.format;
+      view.pixels = frame.buffer ? std::span<const std::uint8_t>(frame.buffer.bytes())
+                                 : std::span<const std::uint8_t>();
+      view.device_timestamp_ns = frame.metadata.device_timestamp_ns;
+      view.received = frame.metadata.received;
+      view.sequence = frame.metadata.sequence;
+      view.status = recordingStatus(frame.metadata.status);
+      if (!frame.buffer && view.status != recording::FrameStatus::kDropped) {
+        view.status = recording::FrameStatus::kMissing;  // no pixels, whatever the driver said
+      }
+      view.reason = statusReason(frame.metadata.status);
+    }
+    const recording::WriteOutcome outcome = writer_.write(record);
+    set = core::FrameSet{};  // buffers back to the pool now, not at the next pop
+    if (!outcome.ok()) {
+      alarm_ = outcome.message;
+      recording_stopped_ = true;
+      spdlog::error("acquisition: recording stopped: {}", outcome.message);
+      continue;
+    }
+    recorded_.fetch_add(1, std::memory_order_relaxed);
+    bytes_.store(writer_.bytesWritten(), std::memory_order_relaxed);
+  }
+}
+
+void Acquisition::processLoop() {
+  core::FrameSet set;
+  while (true) {
+    if (!to_processing_->tryPop(set)) {
+      if (!running_)
+        return;
+      std::this_thread::sleep_for(kIdlePoll);
+      continue;
+    }
+    process_(set);
+    set = core::FrameSet{};
+    processed_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+std::size_t Acquisition::poolBytes() const {
+  return rig_->pool().capacity() * rig_->pool().bufferBytes();
+}
+
+AcquisitionStats Acquisition::stats() const {
+  AcquisitionStats s;
+  s.rig = rig_->stats();
+  s.sets_recorded = recorded_.load();
+  s.sets_lost = lost_.load();
+  s.sets_skipped_for_processing = skipped_.load();
+  s.sets_processed = processed_.load();
+  s.bytes_written = bytes_.load();
+  s.recording_stopped = recording_stopped_.load();
+  if (s.recording_stopped)
+    s.alarm = alarm_;
+  return s;
+}
+
+}  // namespace fieldrig::daemon
