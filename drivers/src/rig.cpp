@@ -6,6 +6,8 @@ namespace fieldrig::drivers {
 namespace {
 // The rig thread sleeps this long when nothing arrived: sets leave at most this late.
 constexpr auto kIdlePoll = std::chrono::microseconds{200};
+// Sets waiting for their frames at once: 256 triggers span 25 s at 10 Hz, far beyond any timeout.
+constexpr std::size_t kMaxPendingSets = 256;
 // Per camera: frames the rig thread may lag behind before a frame is dropped (counted).
 constexpr std::size_t kFrameQueueCapacity = 64;
 }  // namespace
@@ -40,6 +42,7 @@ Rig::Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras)
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
     frame_queues_.push_back(std::make_unique<core::SpscQueue<core::Frame>>(kFrameQueueCapacity));
   }
+  pending_.resize(kMaxPendingSets);
 }
 
 Rig::~Rig() {
@@ -106,7 +109,16 @@ bool Rig::drain() {
   std::pair<std::uint64_t, core::SteadyTime> trigger;
   while (trigger_queue_.tryPop(trigger)) {
     any = true;
-    Pending& pending = pending_[trigger.first];
+    if (pending_count_ == pending_.size()) {
+      // Every slot waits on a camera: the oldest leaves now, incomplete, to make room.
+      forced_out_.fetch_add(1, std::memory_order_relaxed);
+      emit(pending_[pending_head_]);
+      popFront();
+    }
+    Pending& pending = pending_[(pending_head_ + pending_count_) % pending_.size()];
+    ++pending_count_;
+    pending.set = core::FrameSet{};  // releases nothing: emitted slots are already empty
+    pending.arrived = 0;
     pending.set.trigger_id = trigger.first;
     pending.set.camera_count = static_cast<std::uint32_t>(cameras_.size());
     for (std::uint32_t c = 0; c < cameras_.size(); ++c) {
@@ -120,30 +132,45 @@ bool Rig::drain() {
   for (auto& queue : frame_queues_) {
     while (queue->tryPop(frame)) {
       any = true;
-      const auto it = pending_.find(frame.metadata.trigger_id);
+      Pending* pending = findPending(frame.metadata.trigger_id);
       const std::uint32_t camera = frame.metadata.camera;
-      if (it == pending_.end() || camera >= cameras_.size() ||
-          it->second.set.frames[camera].metadata.status != core::FrameStatus::kMissing) {
+      if (pending == nullptr || camera >= cameras_.size() ||
+          pending->set.frames[camera].metadata.status != core::FrameStatus::kMissing) {
         unexpected_.fetch_add(1, std::memory_order_relaxed);
+        frame = core::Frame{};  // its buffer back to the pool at once
         continue;
       }
-      it->second.set.frames[camera] = std::move(frame);
-      ++it->second.arrived;
+      pending->set.frames[camera] = std::move(frame);
+      ++pending->arrived;
     }
   }
   return any;
 }
 
+Rig::Pending* Rig::findPending(std::uint64_t trigger_id) {
+  // Newest first: frames mostly belong to the latest triggers. At most kMaxPendingSets steps.
+  for (std::size_t i = pending_count_; i-- > 0;) {
+    Pending& pending = pending_[(pending_head_ + i) % pending_.size()];
+    if (pending.set.trigger_id == trigger_id)
+      return &pending;
+  }
+  return nullptr;
+}
+
+void Rig::popFront() {
+  pending_head_ = (pending_head_ + 1) % pending_.size();
+  --pending_count_;
+}
+
 void Rig::emitReady(bool flush_all) {
   const core::SteadyTime now = std::chrono::steady_clock::now();
   // In trigger order: a set leaves when whole or timed out, and never before an older one.
-  while (!pending_.empty()) {
-    auto it = pending_.begin();
-    Pending& pending = it->second;
+  while (pending_count_ > 0) {
+    Pending& pending = pending_[pending_head_];
     if (!flush_all && pending.arrived < cameras_.size() && now < pending.deadline)
       break;
     emit(pending);
-    pending_.erase(it);
+    popFront();
   }
 }
 
@@ -189,6 +216,7 @@ RigStats Rig::stats() const {
   s.frames_dropped = frames_dropped_.load();
   s.frames_unexpected = unexpected_.load();
   s.skew_flagged = skew_flagged_.load();
+  s.sets_forced_out = forced_out_.load();
   s.max_skew_ns = max_skew_ns_.load();
   return s;
 }

@@ -200,3 +200,76 @@ TEST(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
 
 }  // namespace
 }  // namespace fieldrig::drivers
+
+namespace fieldrig::drivers {
+namespace {
+
+TEST(RigTest, TooManyWaitingSetsLeaveOldestFirstIncomplete) {
+  RigOptions options = sixCameras(16, 8);
+  options.cameras[1].options["drop_every"] = "1";    // camera 1 never delivers
+  options.frame_timeout = std::chrono::seconds{30};  // so only the ring's size lets sets go
+  options.pool_sets = 300;
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  std::vector<std::uint64_t> order;
+  std::mutex mutex;
+  ASSERT_TRUE((*rig)
+                  ->start([&](core::FrameSet&& set) {
+                    std::lock_guard lock(mutex);
+                    order.push_back(set.trigger_id);
+                    EXPECT_EQ(set.frames[1].metadata.status, core::FrameStatus::kMissing);
+                  })
+                  .ok());
+  for (std::uint64_t id = 1; id <= 300; ++id) {
+    ASSERT_TRUE((*rig)->trigger(id));
+    if (id % 50 == 0)
+      std::this_thread::sleep_for(20ms);  // let the rig thread keep up with the trigger queue
+  }
+  const auto deadline = std::chrono::steady_clock::now() + 5s;
+  while (std::chrono::steady_clock::now() < deadline && (*rig)->stats().sets_forced_out < 44)
+    std::this_thread::sleep_for(1ms);
+  EXPECT_EQ((*rig)->stats().sets_forced_out, 44u);  // 300 waiting sets, room for 256
+  (*rig)->stop();                                   // the remaining 256 leave, incomplete, in order
+  std::lock_guard lock(mutex);
+  ASSERT_EQ(order.size(), 300u);
+  for (std::size_t i = 0; i < order.size(); ++i)
+    EXPECT_EQ(order[i], i + 1);
+}
+
+}  // namespace
+}  // namespace fieldrig::drivers
+
+namespace fieldrig::drivers {
+namespace {
+
+TEST(RigTest, FramesArrivingShuffledAcrossTriggersAreGroupedRight) {
+  RigOptions options = sixCameras();
+  // Each camera answers with its own delay: camera 3's frame of trigger 1 arrives after camera
+  // 0's frames of triggers 2-6.
+  const int delays_ms[] = {0, 15, 5, 25, 10, 20};
+  for (int c = 0; c < 6; ++c)
+    options.cameras[c].options["delay_ms"] = std::to_string(delays_ms[c]);
+  options.pool_sets = 64;
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  Collector collector;
+  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
+  for (std::uint64_t id = 1; id <= 30; ++id) {
+    ASSERT_TRUE((*rig)->trigger(id));
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_TRUE(collector.waitFor(30));
+  (*rig)->stop();
+  const auto sets = collector.take();
+  ASSERT_EQ(sets.size(), 30u);
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    EXPECT_EQ(sets[i].trigger_id, i + 1);
+    EXPECT_TRUE(sets[i].complete());
+    for (std::uint32_t c = 0; c < 6; ++c)
+      EXPECT_TRUE(patternMatches(sets[i].frames[c])) << "set " << i << " camera " << c;
+  }
+  EXPECT_EQ((*rig)->stats().frames_unexpected, 0u);
+}
+
+}  // namespace
+}  // namespace fieldrig::drivers

@@ -14,7 +14,6 @@
 #include <atomic>
 #include <chrono>
 #include <functional>
-#include <map>
 #include <memory>
 #include <string>
 #include <thread>
@@ -45,6 +44,7 @@ struct RigStats {
   std::uint64_t frames_dropped = 0;     // pool exhausted or rig queue full
   std::uint64_t frames_unexpected = 0;  // for no pending trigger (late, or never triggered)
   std::uint64_t skew_flagged = 0;
+  std::uint64_t sets_forced_out = 0;  // left incomplete early: too many sets were waiting
   std::int64_t max_skew_ns = 0;
 };
 
@@ -82,6 +82,8 @@ class Rig {
   bool drain();
   void emitReady(bool flush_all);
   void emit(Pending& pending);
+  Pending* findPending(std::uint64_t trigger_id);
+  void popFront();
 
   RigOptions options_;
   std::vector<std::unique_ptr<Camera>> cameras_;
@@ -89,7 +91,11 @@ class Rig {
   std::vector<std::unique_ptr<core::SpscQueue<core::Frame>>> frame_queues_;  // one per camera
   core::SpscQueue<std::pair<std::uint64_t, core::SteadyTime>> trigger_queue_{1024};
   SetSink sink_;
-  std::map<std::uint64_t, Pending> pending_;  // rig thread only
+  // Sets waiting for frames, oldest at pending_head_: a ring allocated at construction, so that
+  // grouping allocates nothing per set (rig thread only).
+  std::vector<Pending> pending_;
+  std::size_t pending_head_ = 0;
+  std::size_t pending_count_ = 0;
   std::atomic<bool> running_{false};
   std::thread thread_;
 
@@ -97,7 +103,7 @@ class Rig {
   std::atomic<std::uint64_t> triggers_{0}, triggers_refused_{0}, camera_refusals_{0},
       frames_dropped_{0};
   std::atomic<std::uint64_t> sets_{0}, incomplete_{0}, missing_{0}, corrupt_{0}, unexpected_{0},
-      skew_flagged_{0};
+      skew_flagged_{0}, forced_out_{0};
   std::atomic<std::int64_t> max_skew_ns_{0};
 };
 
