@@ -184,6 +184,8 @@ void Rig::emit(Pending& pending) {
       missing_.fetch_add(1, std::memory_order_relaxed);
     if (m.status == core::FrameStatus::kCorrupt)
       corrupt_.fetch_add(1, std::memory_order_relaxed);
+    if (m.status == core::FrameStatus::kDropped)  // the driver found the pool exhausted
+      frames_dropped_.fetch_add(1, std::memory_order_relaxed);
     if (m.status != core::FrameStatus::kOk && m.status != core::FrameStatus::kCorrupt)
       continue;
     earliest = first ? m.device_timestamp_ns : std::min(earliest, m.device_timestamp_ns);
@@ -202,6 +204,9 @@ void Rig::emit(Pending& pending) {
     incomplete_.fetch_add(1, std::memory_order_relaxed);
   if (sink_)
     sink_(std::move(set));
+  // A sink may copy instead of moving (the acquisition pushes copies to two queues): the slot
+  // lets go of its buffers now, not when it is reused 256 triggers later.
+  set = core::FrameSet{};
 }
 
 RigStats Rig::stats() const {

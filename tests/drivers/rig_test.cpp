@@ -184,6 +184,56 @@ TEST(RigTest, BuffersReturnToThePoolWhenConsumersLetGo) {
   EXPECT_EQ((*rig)->pool().available(), (*rig)->pool().capacity());
 }
 
+TEST(RigTest, BuffersReturnEvenWhenTheSinkCopiesTheSet) {
+  RigOptions options = sixCameras();
+  options.pool_sets = 4;  // fewer buffers than triggers: they must come back to be reused
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok());
+  std::atomic<int> complete{0};
+  ASSERT_TRUE((*rig)
+                  ->start([&](core::FrameSet&& set) {
+                    const core::FrameSet copy = set;  // copies, as queue pushes do
+                    if (copy.complete())
+                      ++complete;
+                  })
+                  .ok());
+  for (std::uint64_t id = 1; id <= 40; ++id) {
+    ASSERT_TRUE((*rig)->trigger(id));
+    std::this_thread::sleep_for(3ms);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + 5s;
+  while (std::chrono::steady_clock::now() < deadline && (*rig)->stats().sets < 40)
+    std::this_thread::sleep_for(1ms);
+  (*rig)->stop();
+  EXPECT_EQ(complete.load(), 40);
+  EXPECT_EQ((*rig)->stats().frames_dropped, 0u);
+  EXPECT_EQ((*rig)->pool().available(), (*rig)->pool().capacity());
+}
+
+TEST(RigTest, ExhaustedPoolShowsAsDroppedFrames) {
+  RigOptions options = sixCameras();
+  options.pool_sets = 2;  // 12 buffers
+  auto rig = Rig::create(options, CameraRegistry::instance());
+  ASSERT_TRUE(rig.ok());
+  Collector collector;  // keeps every set: nothing returns to the pool
+  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
+  for (std::uint64_t id = 1; id <= 4; ++id) {
+    ASSERT_TRUE((*rig)->trigger(id));
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_TRUE(collector.waitFor(4));
+  (*rig)->stop();
+  const auto sets = collector.take();
+  EXPECT_TRUE(sets[0].complete());
+  EXPECT_TRUE(sets[1].complete());
+  for (std::size_t i = 2; i < 4; ++i) {
+    for (std::uint32_t c = 0; c < 6; ++c)
+      EXPECT_EQ(sets[i].frames[c].metadata.status, core::FrameStatus::kDropped);
+  }
+  EXPECT_EQ((*rig)->stats().frames_dropped, 12u);
+  EXPECT_EQ((*rig)->stats().incomplete_sets, 2u);
+}
+
 TEST(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
   RigOptions options = sixCameras();
   options.cameras[4].id = "left";
