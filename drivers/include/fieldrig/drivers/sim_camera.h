@@ -1,9 +1,33 @@
 // The simulator camera: a real driver (same interface as the hardware ones) that serves a
-// generated frame per trigger, so that rig, recording and pipeline run without hardware.
+// generated frame per trigger, or replays a recorded session, so that rig, recording and pipeline
+// run without hardware.
 //
-// Each frame is a deterministic pattern of (camera, trigger id): readers can check that the
-// pixels they got belong to the frame the metadata names. Faults are injected on request through
-// CameraConfig::options:
+// Generated: each frame is a deterministic pattern of (camera, trigger id): readers can check that
+// the pixels they got belong to the frame the metadata names.
+//
+// Replay, with the option session=DIR: the camera's id is a camera index of the recorded session,
+// and trigger k after start() (counted by trigger id: set (id - first id) mod N of the session's
+// N sets) serves that set's recorded frame of this camera. Counting by id rather than by triggers
+// taken keeps the six cameras on the same set even when one of them refused a trigger. After
+// the last set the replay wraps around to the first: a long replay (a bench, a soak test) never
+// runs dry. What was recorded comes out again:
+//   - the pixels, byte for byte, and the recorded pixel format (the configured one is ignored);
+//   - kOk and kCorrupt frames with their status; a recorded kMissing frame is not delivered at
+//     all, so the rig times it out as missing again; a recorded kDropped one is delivered as
+//     kDropped without pixels (what the sim does when its pool is dry);
+//   - the device timestamps relative to the set's earliest one, added to the trigger instant:
+//     the recorded skew between cameras is the replayed skew.
+// configure() fails, naming the folder, when the session cannot be opened, has no sets, has no
+// frame of this camera, or when a recorded frame is not the configured width × height (the rig
+// sizes its pool from the configuration, so the configuration must say the recorded size).
+// Frames are read into memory at configure() when this camera's frames total at most
+// session_preload_mb=M MiB (default 64: every test session, a few dozen full frames): the worker
+// then only copies, and a damaged file is an error at configure(). A larger session is read
+// frame by frame on the worker thread, after each trigger (never on the trigger thread): memory
+// stays bounded whatever the session's length; a frame that cannot be read then is delivered
+// kCorrupt with zeroed pixels (the file is damaged; `fieldrig session info --verify` names it).
+//
+// Faults are injected on request through CameraConfig::options, on generated and replayed frames:
 //   drop_every=N     no frame for trigger ids divisible by N
 //   corrupt_every=N  frames of trigger ids divisible by N are delivered marked kCorrupt
 //   delay_ms=D       each frame is delivered D ms after its trigger
@@ -14,6 +38,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <thread>
 #include <vector>
 
@@ -46,8 +71,19 @@ class SimCamera final : public Camera {
     core::SteadyTime at{};
   };
 
+  // The recorded session being replayed (session=DIR); defined in the .cpp so that this header
+  // does not pull in the recording library's.
+  struct Replay;
+
+  // Opens the session of config.options["session"] for camera `index`, checked against the
+  // configuration; errors name the folder.
+  static core::Result<std::unique_ptr<Replay>> openReplay(const CameraConfig& config,
+                                                          std::uint32_t index,
+                                                          std::int64_t preload_mb);
   void run();
   void produce(const PendingTrigger& pending);
+  // Fills `frame` from the recorded set of this trigger; false when nothing is to be delivered.
+  bool replayInto(const PendingTrigger& pending, core::Frame& frame);
 
   CameraConfig config_;
   std::uint32_t camera_index_ = 0;
@@ -62,6 +98,7 @@ class SimCamera final : public Camera {
   std::atomic<bool> running_{false};
   std::uint64_t sequence_ = 0;              // worker thread only
   std::vector<std::uint8_t> row_template_;  // x * 3 for one row, built by configure()
+  std::unique_ptr<Replay> replay_;          // null when generating; set by configure()
   std::thread worker_;
 };
 
