@@ -95,6 +95,55 @@ void BM_HandOff_MutexConditionVariable(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kSetsPerIteration);
 }
 
+// The queues alone: a 32-bit handle per set, no pool traffic, so only the hand-off is timed.
+void BM_QueueOnly_LockFreeSpsc(benchmark::State& state) {
+  for (auto _ : state) {
+    SpscQueue<std::uint32_t> queue(kQueueCapacity);
+    std::thread consumer([&] {
+      std::uint32_t handle = 0;
+      for (int received = 0; received < kSetsPerIteration;) {
+        if (queue.tryPop(handle))
+          ++received;
+      }
+    });
+    for (int i = 0; i < kSetsPerIteration; ++i) {
+      while (!queue.tryPush(static_cast<std::uint32_t>(i))) {
+      }
+    }
+    consumer.join();
+  }
+  state.SetItemsProcessed(state.iterations() * kSetsPerIteration);
+}
+
+void BM_QueueOnly_MutexConditionVariable(benchmark::State& state) {
+  for (auto _ : state) {
+    std::mutex mutex;
+    std::condition_variable not_empty, not_full;
+    std::vector<std::uint32_t> ring(kQueueCapacity);
+    std::size_t head = 0, count = 0;
+    std::thread consumer([&] {
+      for (int received = 0; received < kSetsPerIteration; ++received) {
+        std::unique_lock lock(mutex);
+        not_empty.wait(lock, [&] { return count > 0; });
+        head = (head + 1) % ring.size();
+        --count;
+        not_full.notify_one();
+      }
+    });
+    for (int i = 0; i < kSetsPerIteration; ++i) {
+      std::unique_lock lock(mutex);
+      not_full.wait(lock, [&] { return count < ring.size(); });
+      ring[(head + count) % ring.size()] = static_cast<std::uint32_t>(i);
+      ++count;
+      not_empty.notify_one();
+    }
+    consumer.join();
+  }
+  state.SetItemsProcessed(state.iterations() * kSetsPerIteration);
+}
+
+BENCHMARK(BM_QueueOnly_LockFreeSpsc)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_QueueOnly_MutexConditionVariable)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_HandOff_LockFreeSpsc)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_HandOff_MutexConditionVariable)->Unit(benchmark::kMillisecond)->UseRealTime();
 
