@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "fieldrig/drivers/sim_camera.h"
+#include "support/frame_set_collector.h"
 
 namespace fieldrig::drivers {
 namespace {
@@ -27,36 +28,7 @@ RigOptions sixCameras(std::uint32_t width = 64, std::uint32_t height = 48) {
   return options;
 }
 
-// Collects sets on the rig thread; the test thread waits for a count.
-class Collector {
- public:
-  Rig::SetSink sink() {
-    return [this](core::FrameSet&& set) {
-      std::lock_guard lock(mutex_);
-      sets_.push_back(std::move(set));
-    };
-  }
-  bool waitFor(std::size_t count, std::chrono::milliseconds timeout = 5s) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      {
-        std::lock_guard lock(mutex_);
-        if (sets_.size() >= count)
-          return true;
-      }
-      std::this_thread::sleep_for(1ms);
-    }
-    return false;
-  }
-  std::vector<core::FrameSet> take() {
-    std::lock_guard lock(mutex_);
-    return std::move(sets_);
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<core::FrameSet> sets_;  // guarded by mutex_
-};
+using Collector = testing_support::FrameSetCollector;
 
 bool patternMatches(const core::Frame& frame) {
   const auto& m = frame.metadata;

@@ -16,6 +16,7 @@
 #include "fieldrig/drivers/sim_camera.h"
 #include "fieldrig/recording/session_reader.h"
 #include "support/cli_run.h"
+#include "support/frame_set_collector.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig::drivers {
@@ -79,36 +80,7 @@ RigOptions replayingRig(const std::filesystem::path& session,
   return options;
 }
 
-// Collects sets on the rig thread; the test thread waits for a count.
-class Collector {
- public:
-  Rig::SetSink sink() {
-    return [this](core::FrameSet&& set) {
-      std::lock_guard lock(mutex_);
-      sets_.push_back(std::move(set));
-    };
-  }
-  bool waitFor(std::size_t count, std::chrono::milliseconds timeout = 10s) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      {
-        std::lock_guard lock(mutex_);
-        if (sets_.size() >= count)
-          return true;
-      }
-      std::this_thread::sleep_for(1ms);
-    }
-    return false;
-  }
-  std::vector<core::FrameSet> take() {
-    std::lock_guard lock(mutex_);
-    return std::move(sets_);
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<core::FrameSet> sets_;  // guarded by mutex_
-};
+using Collector = testing_support::FrameSetCollector;
 
 core::FrameStatus expectedStatus(recording::FrameStatus recorded) {
   switch (recorded) {
