@@ -18,20 +18,6 @@ const std::vector<std::string>& defaultCameraNames() {
   return names;
 }
 
-recording::FrameStatus recordingStatus(core::FrameStatus status) {
-  switch (status) {
-    case core::FrameStatus::kOk:
-      return recording::FrameStatus::kOk;
-    case core::FrameStatus::kCorrupt:
-      return recording::FrameStatus::kCorrupt;
-    case core::FrameStatus::kDropped:
-      return recording::FrameStatus::kDropped;
-    case core::FrameStatus::kMissing:
-      break;
-  }
-  return recording::FrameStatus::kMissing;
-}
-
 std::string_view statusReason(core::FrameStatus status) {
   switch (status) {
     case core::FrameStatus::kOk:
@@ -163,9 +149,9 @@ void Acquisition::recordLoop() {
       view.device_timestamp_ns = frame.metadata.device_timestamp_ns;
       view.received = frame.metadata.received;
       view.sequence = frame.metadata.sequence;
-      view.status = recordingStatus(frame.metadata.status);
-      if (!frame.buffer && view.status != recording::FrameStatus::kDropped) {
-        view.status = recording::FrameStatus::kMissing;  // no pixels, whatever the driver said
+      view.status = frame.metadata.status;
+      if (!frame.buffer && view.status != core::FrameStatus::kDropped) {
+        view.status = core::FrameStatus::kMissing;  // no pixels, whatever the driver said
       }
       view.reason = statusReason(frame.metadata.status);
     }

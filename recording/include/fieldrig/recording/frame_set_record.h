@@ -10,19 +10,16 @@
 #include <string_view>
 #include <vector>
 
+#include "fieldrig/core/frame.h"
 #include "fieldrig/core/gps_fix.h"
 #include "fieldrig/core/pixel_format.h"
 #include "fieldrig/core/time.h"
 
 namespace fieldrig::recording {
 
-// Why a frame is (or is not) what the camera should have delivered.
-enum class FrameStatus {
-  kOk,
-  kMissing,  // no frame arrived for this trigger (timeout, dropped); no pixels
-  kCorrupt,  // pixels arrived but are known to be damaged (lost packets, short frame)
-  kDropped,  // the frame was not kept on the host (no free buffer); no pixels
-};
+// Why a frame is (or is not) what the camera should have delivered: the drivers' own status
+// (ok, missing, corrupt, dropped), so frames are recorded as the rig reported them.
+using FrameStatus = core::FrameStatus;
 
 std::string_view toString(FrameStatus status);
 std::optional<FrameStatus> parseFrameStatus(std::string_view name);
