@@ -15,6 +15,11 @@ packages=(
   # The aravis driver and its tests (arv-fake-gv-camera-0.8); Debian's aravis-0.8.pc also
   # needs libusb-1.0's .pc file, which libaravis-dev does not pull in.
   libaravis-dev aravis-tools libusb-1.0-0-dev
+  # The feature pipeline: OpenCV with contrib (ximgproc's WLS filter), PCL with Qhull, Eigen.
+  # Debian's PCL pulls VTK, whose CMake config wants MPI's C target.
+  libopencv-dev libopencv-contrib-dev libpcl-dev libeigen3-dev mpi-default-dev
+  # stem-ui's browser test drives Debian's headless Chromium (Playwright comes from npm).
+  chromium
 )
 
 missing=()

@@ -1,0 +1,77 @@
+// Semi-global matching of a rectified pair (OpenCV's StereoSGBM) with the post-processing the
+// field images need: a left–right consistency check with a real right-view matcher, speckle
+// removal, and optionally opencv_contrib's weighted-least-squares (WLS) filter.
+#pragma once
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/ximgproc/disparity_filter.hpp>
+
+namespace fieldrig::stereo {
+
+// Disparities below this value mark invalid pixels in every float map this library returns.
+inline constexpr float kInvalidDisparity = -1.0f;
+
+struct MatcherOptions {
+  int num_disparities = 128;  // multiple of 16
+  int min_disparity = 0;
+  int block_size = 5;  // odd
+  // P1 = p1_per_pixel · channels · block², P2 likewise (OpenCV's own suggestion is 8 and 32).
+  int p1_per_pixel = 8;
+  int p2_per_pixel = 32;
+  int pre_filter_cap = 63;
+  int uniqueness_ratio = 10;
+  int speckle_window = 100;  // pixels; 0 disables speckle filtering
+  int speckle_range = 2;     // pixels of disparity within one speckle
+  // SGBM's own left–right check from the left cost volume (cheap); -1 disables it.
+  int disp12_max_diff = 1;
+  // Match the right view as well and keep left pixels whose right match points back within
+  // lr_max_diff pixels (doubles the matching time).
+  bool lr_check = false;
+  float lr_max_diff = 1.0f;
+  // opencv_contrib WLS filter (needs the right view; it fills invalid pixels).
+  bool wls = false;
+  double wls_lambda = 8000.0;
+  double wls_sigma = 1.5;
+  int mode = cv::StereoSGBM::MODE_SGBM_3WAY;
+  bool match_colour = false;  // true: SGBM on BGR (3 channels), false: on grey
+};
+
+// Per-call timings of DisparityMatcher::compute, milliseconds.
+struct MatchTimings {
+  double sgbm_ms = 0;    // left (and right) matcher
+  double filter_ms = 0;  // LR check, WLS, conversion to float
+};
+
+// Thread contract: thread-compatible; one instance per thread (StereoSGBM keeps buffers).
+class DisparityMatcher {
+ public:
+  explicit DisparityMatcher(const MatcherOptions& options);
+
+  // Left-view disparity in pixels (CV_32F), kInvalidDisparity where no reliable match. Inputs:
+  // rectified, same size; BGR or grey (converted as match_colour says).
+  cv::Mat compute(const cv::Mat& left, const cv::Mat& right, MatchTimings* timings = nullptr);
+
+  const MatcherOptions& options() const { return options_; }
+
+ private:
+  MatcherOptions options_;
+  cv::Ptr<cv::StereoSGBM> left_matcher_;
+  cv::Ptr<cv::StereoMatcher> right_matcher_;
+  cv::Ptr<cv::ximgproc::DisparityWLSFilter> wls_;
+};
+
+// The baseline of the issue: plain OpenCV SGBM "with default parameters", i.e.
+// cv::StereoSGBM::create(0, num_disparities, 3) and nothing else set (P1 = P2 = 0,
+// disp12MaxDiff = 0, preFilterCap = 0, uniquenessRatio = 0, no speckle filter, MODE_SGBM), on
+// grey images. Returns the left disparity in pixels, kInvalidDisparity where SGBM gave none.
+cv::Mat computeDefaultSgbm(const cv::Mat& left, const cv::Mat& right, int num_disparities);
+
+// Keeps pixels of `left_disparity` whose match in `right_disparity` (right view, positive
+// pixels, kInvalidDisparity = none) lies within `max_diff`; the others become invalid.
+void leftRightCheck(cv::Mat& left_disparity, const cv::Mat& right_disparity, float max_diff);
+
+// Fixed-point SGBM output (CV_16S, ×16) → float pixels with kInvalidDisparity below min_disparity.
+cv::Mat toFloatDisparity(const cv::Mat& fixed_point, int min_disparity);
+
+}  // namespace fieldrig::stereo

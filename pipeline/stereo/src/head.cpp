@@ -1,0 +1,78 @@
+#include "fieldrig/stereo/head.h"
+
+#include <chrono>
+
+#include "fieldrig/stereo/preprocess.h"
+
+namespace fieldrig::stereo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::string sizeText(cv::Size size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+}  // namespace
+
+core::Result<HeadPipeline> HeadPipeline::create(const StereoCalibration& calibration,
+                                                const HeadOptions& options) {
+  if (calibration.image_size.empty()) {
+    return core::Error{"calibration has no image size (image_width/image_height in intrinsics)"};
+  }
+  if (options.matcher.num_disparities <= 0 || options.matcher.num_disparities % 16 != 0) {
+    return core::Error{"num_disparities " + std::to_string(options.matcher.num_disparities) +
+                       " is not a positive multiple of 16"};
+  }
+  const StereoCalibration scaled = calibration.scaled(options.scale);
+  core::Result<Rectifier> rectifier = Rectifier::create(scaled);
+  if (!rectifier)
+    return rectifier.error();
+  HeadPipeline head(scaled, std::move(*rectifier), options);
+  head.camera_size_ = calibration.image_size;
+  return head;
+}
+
+core::Result<HeadOutput> HeadPipeline::process(const cv::Mat& raw_left, const cv::Mat& raw_right,
+                                               core::PixelFormat format, const std::string& name,
+                                               HeadTimings* timings) {
+  for (const auto& [side, raw] : {std::pair{"left", &raw_left}, {"right", &raw_right}}) {
+    if (raw->empty()) {
+      return core::Error{name + ": " + side + " image is missing"};
+    }
+    if (raw->size() != camera_size_) {
+      return core::Error{name + ": " + side + " image is " + sizeText(raw->size()) +
+                         " but the calibration is for " + sizeText(camera_size_)};
+    }
+    double max_level = 0;
+    cv::minMaxLoc(raw->reshape(1), nullptr, &max_level);
+    if (max_level < options_.blank_max_level) {
+      return core::Error{name + ": " + side + " image is blank (brightest pixel " +
+                         std::to_string(static_cast<int>(max_level)) + ")"};
+    }
+  }
+  auto start = Clock::now();
+  core::Result<cv::Mat> left = debayerAndScale(raw_left, format, options_.scale);
+  if (!left)
+    return core::Error{name + ": left image: " + left.error().message};
+  core::Result<cv::Mat> right = debayerAndScale(raw_right, format, options_.scale);
+  if (!right)
+    return core::Error{name + ": right image: " + right.error().message};
+  if (timings)
+    timings->debayer_ms = msSince(start);
+  start = Clock::now();
+  HeadOutput out;
+  cv::Mat right_rectified;
+  rectifier_.rectify(*left, *right, out.left_bgr, right_rectified);
+  if (timings)
+    timings->rectify_ms = msSince(start);
+  out.disparity =
+      matcher_.compute(out.left_bgr, right_rectified, timings ? &timings->match : nullptr);
+  return out;
+}
+
+}  // namespace fieldrig::stereo
