@@ -1,0 +1,76 @@
+// One FrameSet's three heads to one point cloud in the plot frame: each head's disparity
+// reprojected with its Q, moved into the bottom head's frame (rig.yml), rotated into the plot
+// frame and cropped by depth. A head that cannot be used (missing or blank frame, wrong size)
+// is flagged and the cloud is built from the others.
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "fieldrig/cloud/rig.h"
+#include "fieldrig/core/result.h"
+#include "fieldrig/stereo/head.h"
+
+namespace fieldrig::cloud {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
+
+// One head's frames: raw Bayer (CV_8UC1, of `pixel_format`) or BGR images; empty = missing.
+struct HeadFrames {
+  cv::Mat left, right;
+  core::PixelFormat pixel_format = core::PixelFormat::kBayerRG8;
+};
+
+struct HeadStatus {
+  std::string name;
+  bool ok = false;
+  std::string problem;  // why the head was left out, when not ok
+  std::size_t points = 0;
+  stereo::HeadTimings timings;
+  double reproject_ms = 0;  // reprojection, transform into the plot frame, crop, colour
+};
+
+struct FusionResult {
+  Cloud cloud;  // plot frame, metres
+  std::vector<HeadStatus> heads;
+  bool partial() const;  // some head was left out
+  double fuse_ms = 0;    // the heads' clouds joined into one
+};
+
+// Appends the valid pixels of `disparity` (CV_32F, stereo::kInvalidDisparity = none), coloured
+// from `left_bgr`, reprojected with `Q` and moved by `to_output` (4×4), keeping points whose
+// output z lies in (min_z, max_z]. Returns the number of points appended.
+std::size_t appendReprojected(const cv::Mat& disparity, const cv::Mat& left_bgr, const cv::Mat& Q,
+                              const cv::Matx44d& to_output, double min_z, double max_z, Cloud& out,
+                              double* reproject_ms = nullptr);
+
+// Thread contract: thread-compatible; one instance per thread.
+class CloudBuilder {
+ public:
+  // Builds each head's pipeline (maps, matchers) once. `matcher` overrides the disparity count
+  // with the rig's num_disparities.
+  static core::Result<CloudBuilder> create(const RigConfig& rig,
+                                           stereo::MatcherOptions matcher = {});
+
+  // `frames` in the order of rig.heads. Never fails for bad frames: the head is flagged.
+  // parallel_heads runs the heads on OpenCV's thread pool at once (each head's SGBM then runs
+  // single-threaded inside it, as OpenCV does not nest parallel loops).
+  FusionResult build(const std::vector<HeadFrames>& frames, bool parallel_heads = false);
+
+  const RigConfig& rig() const { return rig_; }
+
+ private:
+  RigConfig rig_;
+  std::vector<stereo::HeadPipeline> heads_;
+  std::vector<cv::Matx44d> to_plot_;  // head frame → plot frame
+};
+
+// Writes the cloud as binary PLY (x y z and rgb), which CloudCompare and MeshLab read.
+core::Result<std::filesystem::path> writePly(const Cloud& cloud, const std::filesystem::path& file);
+
+}  // namespace fieldrig::cloud

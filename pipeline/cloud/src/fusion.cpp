@@ -1,0 +1,174 @@
+#include "fieldrig/cloud/fusion.h"
+
+#include <pcl/io/ply_io.h>
+
+#include <chrono>
+#include <opencv2/core/utility.hpp>
+
+namespace fieldrig::cloud {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+bool FusionResult::partial() const {
+  for (const HeadStatus& head : heads) {
+    if (!head.ok)
+      return true;
+  }
+  return false;
+}
+
+std::size_t appendReprojected(const cv::Mat& disparity, const cv::Mat& left_bgr, const cv::Mat& Q,
+                              const cv::Matx44d& to_output, double min_z, double max_z, Cloud& out,
+                              double* reproject_ms) {
+  CV_Assert(disparity.type() == CV_32F && left_bgr.type() == CV_8UC3 &&
+            disparity.size() == left_bgr.size() && Q.type() == CV_64F &&
+            Q.size() == cv::Size(4, 4));
+  const auto start = Clock::now();
+  // cv::reprojectImageTo3D would fill a 3-channel float image for every pixel (invalid ones
+  // included) that is then read again to transform and crop. Here Q and the transform are one
+  // 4×4 matrix applied to the valid pixels only, in the same pass that crops and colours:
+  // (X, Y, Z, W) = (to_output · Q) · (x, y, d, 1), as reprojectImageTo3D computes Q · (x, y, d, 1).
+  const cv::Matx44d a = to_output * cv::Matx44d(Q);
+  cv::Matx44f m;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c)
+      m(r, c) = static_cast<float>(a(r, c));
+  }
+  const auto min_zf = static_cast<float>(min_z);
+  const auto max_zf = static_cast<float>(max_z);
+  const std::size_t before = out.size();
+  out.reserve(before + static_cast<std::size_t>(cv::countNonZero(disparity > 0)));
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    const cv::Vec3b* colour = left_bgr.ptr<cv::Vec3b>(y);
+    const auto yf = static_cast<float>(y);
+    // The row's contribution is constant along it.
+    const float row[4] = {m(0, 1) * yf + m(0, 3), m(1, 1) * yf + m(1, 3), m(2, 1) * yf + m(2, 3),
+                          m(3, 1) * yf + m(3, 3)};
+    for (int x = 0; x < disparity.cols; ++x) {
+      // Zero disparity is a point at infinity; negative or NaN is no match.
+      if (!(d[x] > 0))
+        continue;
+      const auto xf = static_cast<float>(x);
+      const float w = m(3, 0) * xf + m(3, 2) * d[x] + row[3];
+      const float z = (m(2, 0) * xf + m(2, 2) * d[x] + row[2]) / w;
+      if (!(z > min_zf && z <= max_zf))
+        continue;
+      pcl::PointXYZRGB point;
+      point.x = (m(0, 0) * xf + m(0, 2) * d[x] + row[0]) / w;
+      point.y = (m(1, 0) * xf + m(1, 2) * d[x] + row[1]) / w;
+      point.z = z;
+      point.b = colour[x][0];
+      point.g = colour[x][1];
+      point.r = colour[x][2];
+      out.push_back(point);
+    }
+  }
+  if (reproject_ms)
+    *reproject_ms = msSince(start);
+  return out.size() - before;
+}
+
+core::Result<CloudBuilder> CloudBuilder::create(const RigConfig& rig,
+                                                stereo::MatcherOptions matcher) {
+  if (rig.heads.empty()) {
+    return core::Error{"the rig has no heads"};
+  }
+  CloudBuilder builder;
+  builder.rig_ = rig;
+  stereo::HeadOptions options;
+  options.scale = rig.scale;
+  options.matcher = matcher;
+  options.matcher.num_disparities = rig.num_disparities;
+  options.matcher.min_disparity = rig.min_disparity;
+  cv::Matx44d plot = cv::Matx44d::eye();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c)
+      plot(r, c) = rig.plot_rotation(r, c);
+  }
+  for (const HeadConfig& head : rig.heads) {
+    core::Result<stereo::HeadPipeline> pipeline =
+        stereo::HeadPipeline::create(head.calibration, options);
+    if (!pipeline)
+      return core::Error{head.name + " head: " + pipeline.error().message};
+    builder.heads_.push_back(std::move(*pipeline));
+    builder.to_plot_.push_back(plot * head.to_bottom);
+  }
+  return builder;
+}
+
+FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool parallel_heads) {
+  FusionResult result;
+  result.heads.resize(heads_.size());
+  std::vector<Cloud> head_clouds(heads_.size());
+  auto runHead = [&](std::size_t i) {
+    HeadStatus& status = result.heads[i];
+    status.name = rig_.heads[i].name;
+    if (i >= frames.size()) {
+      status.problem = status.name + ": no frames given";
+      return;
+    }
+    // The head checks its input first; an OpenCV failure past those checks still only costs
+    // this head, never the FrameSet.
+    try {
+      core::Result<stereo::HeadOutput> output = heads_[i].process(
+          frames[i].left, frames[i].right, frames[i].pixel_format, status.name, &status.timings);
+      if (!output) {
+        status.problem = output.error().message;
+        return;
+      }
+      status.points = appendReprojected(
+          output->disparity, output->left_bgr, heads_[i].matchingCalibration().Q, to_plot_[i],
+          rig_.min_depth_m, rig_.max_depth_m, head_clouds[i], &status.reproject_ms);
+      status.ok = true;
+    } catch (const cv::Exception& e) {
+      status.problem = status.name + ": OpenCV failed: " + e.what();
+      head_clouds[i].clear();
+      status.points = 0;
+    }
+  };
+  if (parallel_heads) {
+    cv::parallel_for_(cv::Range(0, static_cast<int>(heads_.size())), [&](const cv::Range& range) {
+      for (int i = range.start; i < range.end; ++i)
+        runHead(static_cast<std::size_t>(i));
+    });
+  } else {
+    for (std::size_t i = 0; i < heads_.size(); ++i)
+      runHead(i);
+  }
+  const auto start = Clock::now();
+  std::size_t total = 0;
+  for (const Cloud& cloud : head_clouds)
+    total += cloud.size();
+  result.cloud.reserve(total);
+  for (const Cloud& cloud : head_clouds)
+    result.cloud += cloud;
+  result.cloud.width = static_cast<std::uint32_t>(result.cloud.size());
+  result.cloud.height = 1;
+  result.cloud.is_dense = true;
+  result.fuse_ms = msSince(start);
+  return result;
+}
+
+core::Result<std::filesystem::path> writePly(const Cloud& cloud,
+                                             const std::filesystem::path& file) {
+  if (cloud.empty()) {
+    return core::Error{file.string() + ": the cloud is empty; nothing to write"};
+  }
+  // Without PCL's extra "camera" element (use_camera = false): a plain vertex list with
+  // red/green/blue that every PLY reader takes.
+  pcl::PLYWriter writer;
+  if (writer.write(file.string(), cloud, /*binary=*/true, /*use_camera=*/false) != 0) {
+    return core::Error{file.string() + ": cannot write PLY"};
+  }
+  return file;
+}
+
+}  // namespace fieldrig::cloud
