@@ -1,0 +1,200 @@
+// Plot traits from one fused side-view cloud: ground by template ICP, slices along the row,
+// weighted-median height and width, VVI from per-slice convex hulls, VAI from a surface area.
+// Section 2.3 of the paper (equations 1-9). All lengths in metres, plot frame x up, y along the
+// row, z away from the camera. Pure computation: no I/O, thread-compatible.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace fieldrig::traits {
+
+// How the surface area behind VAI is measured.
+enum class AreaMethod {
+  kDepthMap,     // 2.5D depth-map triangulation per camera-facing layer (fast; the default)
+  kPaperMlsGpt,  // the paper: MovingLeastSquares + GreedyProjectionTriangulation (PCL)
+  kNone,         // skip the area (VAI and total area are reported as 0 with area_computed false)
+};
+
+enum class OutlierMethod {
+  kStatistical,      // PCL StatisticalOutlierRemoval (the paper)
+  kVoxelNeighbours,  // removeSparseOutliers below
+};
+
+struct TraitsOptions {
+  // Camera frame (x right, y down, z forward) to plot frame: applied for camera-frame input.
+  Eigen::Matrix3d camera_to_plot = (Eigen::Matrix3d() << 0, -1, 0, 1, 0, 0, 0, 0, 1).finished();
+  double voxel_leaf_m = 0.01;
+  // Outliers: the paper's PCL StatisticalOutlierRemoval, or (default, ~20x faster) a neighbour
+  // count on the voxel grid: a voxel with fewer occupied cells among its 26 goes.
+  OutlierMethod outlier_method = OutlierMethod::kVoxelNeighbours;
+  int outlier_mean_k = 50;  // StatisticalOutlierRemoval neighbours
+  double outlier_stddev_mul = 1.0;
+  int outlier_min_neighbours = 2;
+  double crop_z_max_m = 1.7;  // background rows beyond this depth are removed
+  double crop_z_min_m = 0.0;
+  double max_abs_coordinate_m = 1.0e4;  // beyond this float precision is worse than 1 mm
+  // Ground: a right-angle plate (a strip toward the camera and one up the plant plane).
+  double template_strip_m = 0.3;
+  double template_step_m = 0.04;       // point spacing of the plate (the paper's: 0.01)
+  double icp_target_leaf_m = 0.02;     // the registration target is voxelised to this
+  double icp_coarse_distance_m = 0.3;  // the paper's correspondence distance
+  double icp_fine_distance_m = 0.03;   // fine stage, so the plate cannot hang on leaves; 0: none
+  int icp_iterations = 10;             // per stage
+  double max_ground_tilt_deg = 15.0;   // a registration tilted further is rejected
+  double ground_margin_m = 0.01;       // points this close above the plate's ground go with it
+  double ground_tilt_deg = 10.0;       // the paper's tilted plane about the base-ground edge
+  // Slicing (equation 15): n = ceil(2 * row length / intra-row spacing) unless slices > 0.
+  double row_length_m = 1.5;
+  double intra_row_spacing_m = 0.15;
+  int slices = 0;
+  double min_row_extent_m = 0.05;  // shorter plants-only extent along y is "one slice only"
+  std::size_t min_plant_points = 50;
+  double alpha = 0.3;               // slice validity: hull volume / slice box volume
+  double alpha_near_margin = 0.05;  // slices whose ratio is this close to alpha are counted
+  AreaMethod area_method = AreaMethod::kDepthMap;
+  double depth_map_cell_m = 0.01;
+  double depth_map_max_step_m = 0.025;  // neighbours further apart in depth are not joined
+  double depth_map_min_fill = 0.6;      // below this mean cell weight the cell size grows
+  double mls_radius_m = 0.03;
+  double gpt_radius_m = 0.05;
+  double gpt_mu = 2.5;
+  int gpt_max_neighbors = 100;
+};
+
+// Fills slices from row length and spacing when it is 0 (equation 15).
+int sliceCount(const TraitsOptions& options);
+
+enum class TraitsStatus {
+  kOk,
+  kEmptyCloud,       // no points at all
+  kNoFinitePoints,   // every point has a NaN or infinite coordinate
+  kHugeCoordinates,  // coordinates too far from the origin for float precision (e.g. UTM)
+  kNoPlants,         // nothing left above the ground (ground only, or no plants)
+  kGroundNotFound,   // the plate could not be registered to a plausible ground
+  kSingleSlice,      // the plants span one slice only along the row
+  kNoValidSlices,    // height and width are valid, but no slice passed alpha: no VVI/VAI
+};
+
+const char* statusName(TraitsStatus status);
+
+struct SliceStats {
+  double y_begin = 0.0;
+  double y_end = 0.0;
+  std::size_t points = 0;
+  double x_max = 0.0;
+  double z_min = 0.0;
+  double z_max = 0.0;
+  std::size_t box_points = 0;  // points inside the refined box (VVI stage)
+  double hull_volume_m3 = 0.0;
+  double box_volume_m3 = 0.0;
+  double ratio = 0.0;  // hull / box
+  bool valid = false;
+};
+
+struct TraitsQuality {
+  std::size_t points_in = 0;
+  std::size_t points_non_finite = 0;
+  std::size_t points_far = 0;         // single points absurdly far from the rest
+  std::size_t points_background = 0;  // cropped by depth
+  std::size_t points_after_voxel = 0;
+  std::size_t points_outliers = 0;       // StatisticalOutlierRemoval
+  std::size_t points_ground = 0;         // below the plate's ground plane (+ margin)
+  std::size_t points_ground_tilted = 0;  // below the 10-degree tilted planes only
+  std::size_t points_plants = 0;
+  std::size_t points_outside_box = 0;
+  double icp_fitness_coarse = -1.0;  // mean squared correspondence distance, m^2 (-1: not run)
+  double icp_fitness_fine = -1.0;
+  bool icp_converged = false;
+  bool icp_fell_back = false;    // the coarse stage tilted too far; fine stage from the data pose
+  double ground_tilt_deg = 0.0;  // angle between the registered ground normal and x
+  Eigen::Vector3d base_edge_centre = Eigen::Vector3d::Zero();
+  int slices = 0;
+  int occupied_slices = 0;
+  int valid_slices = 0;
+  double alpha_margin = 0.0;  // smallest |ratio - alpha| over slices: how close beta is to flipping
+  int slices_near_alpha = 0;
+  bool area_computed = false;
+  double area_cell_m = 0.0;  // depth-map cell actually used
+  double area_fill = 0.0;    // its mean cell weight (1 = closed surface)
+};
+
+struct TraitsTimings {
+  double filter_ms = 0.0;
+  double ground_ms = 0.0;
+  double slices_ms = 0.0;
+  double hulls_ms = 0.0;
+  double area_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+struct TraitsResult {
+  TraitsStatus status = TraitsStatus::kEmptyCloud;
+  std::string message;  // why, when status is not kOk
+  double height_m = 0.0;
+  double width_m = 0.0;
+  double vvi = 0.0;
+  double vai = 0.0;
+  double total_volume_m3 = 0.0;
+  double total_area_m2 = 0.0;
+  double ega_m2 = 0.0;
+  double x_min = 0.0, x_max = 0.0, y_min = 0.0, y_max = 0.0, z_min = 0.0, z_max = 0.0;
+  std::vector<SliceStats> slices;
+  TraitsQuality quality;
+  TraitsTimings timings;
+
+  bool heightWidthValid() const {
+    return status == TraitsStatus::kOk || status == TraitsStatus::kNoValidSlices;
+  }
+  bool volumeValid() const { return status == TraitsStatus::kOk; }
+};
+
+enum class InputFrame { kPlot, kCamera };
+
+// The whole pipeline on a raw fused cloud. Never throws for bad data: the status says why.
+TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFrame frame,
+                           const TraitsOptions& options);
+
+// The trait definitions alone (slices, weighted medians, hulls, area), on points already known to
+// be plants, with the ground level given: used for truth on noise-free synthetic geometry and by
+// computeTraits after its ground stage.
+TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& plant_points, double x_min,
+                                   const TraitsOptions& options);
+
+// Weighted median as in the paper: sort the values, return the first whose cumulative weight
+// reaches half the total. Pairs with non-positive weight are ignored; 0 when nothing is left.
+double weightedMedian(std::vector<std::pair<double, double>> value_weight);
+
+// Surface area by 2.5D depth-map triangulation (seen along +z): cells of `cell` metres in (x, y),
+// each holding the depth layers found there; neighbouring cells are joined into triangles where
+// their depths differ by less than `max_step`. Exposed for tests.
+double depthMapArea(const std::vector<Eigen::Vector3f>& points, double cell, double max_step);
+
+// The same over three viewing directions: each voxel cell goes to the axis its local surface
+// normal (PCA of the 3x3x3 neighbourhood) faces most, and the three depth maps are summed, so that
+// stems and steep leaves seen edge-on along z still count. The VAI estimator of the pipeline.
+// `fill` is the mean triangulation weight of the cells (1 inside a surface, less at rims): a
+// cloud too sparse for the cell size shows as a low fill.
+struct SurfaceArea {
+  double area_m2 = 0.0;
+  double cell_m = 0.0;
+  double fill = 0.0;
+};
+SurfaceArea multiViewDepthMapArea(const std::vector<Eigen::Vector3f>& points, double cell,
+                                  double max_step);
+
+// Drops points with fewer than `min_neighbours` occupied cells among the 26 around their own
+// (cells of `cell` metres on the global grid); `removed` counts them.
+std::vector<Eigen::Vector3f> removeSparseOutliers(const std::vector<Eigen::Vector3f>& points,
+                                                  double cell, int min_neighbours,
+                                                  std::size_t& removed);
+
+// Voxel-grid downsampling with an offset of the grid (PCL VoxelGrid on shifted points): used to
+// measure how much the truth itself moves with the grid's phase.
+std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>& points,
+                                             double leaf, const Eigen::Vector3f& grid_offset);
+
+}  // namespace fieldrig::traits

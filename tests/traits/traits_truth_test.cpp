@@ -1,0 +1,136 @@
+// The whole pipeline on synthetic plots against the truth of the definitions (noise-free
+// visible geometry) and the generator's visible surface area, and the paper's two claims.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fieldrig/sim/plot_generator.h"
+#include "fieldrig/traits/plot_traits.h"
+#include "traits/plot_truth.h"
+
+namespace fieldrig::traits {
+namespace {
+
+using testing_support::plotTruth;
+
+sim::PlotSpec testSpec(double height, double noise, std::uint32_t seed) {
+  sim::PlotSpec spec;
+  spec.plant_height_m = height;
+  spec.depth_noise_m = noise;
+  spec.seed = seed;
+  spec.sample_spacing_m = 0.004;  // lighter than the bench's 3 mm, still dense at 1 cm
+  return spec;
+}
+
+void expectMatchesTruth(const sim::PlotSpec& spec) {
+  const sim::PlotCloud plot = sim::generatePlot(spec);
+  const TraitsOptions options;
+  const auto truth = plotTruth(plot, options);
+  ASSERT_EQ(truth.definitions.status, TraitsStatus::kOk);
+  const TraitsResult r = computeTraits(plot.points, InputFrame::kPlot, options);
+  ASSERT_EQ(r.status, TraitsStatus::kOk) << r.message;
+  EXPECT_NEAR(r.height_m, truth.definitions.height_m, 0.03);
+  EXPECT_NEAR(r.width_m, truth.definitions.width_m, 0.03);
+  EXPECT_NEAR(r.vvi, truth.definitions.vvi, 0.15 * truth.definitions.vvi);
+  EXPECT_NEAR(r.total_area_m2, truth.visible_area_m2, 0.15 * truth.visible_area_m2);
+  EXPECT_NEAR(r.vai, truth.vai, 0.20 * truth.vai);
+  // Quality fields say what happened.
+  EXPECT_GT(r.quality.points_ground, 0U);
+  EXPECT_GT(r.quality.points_background, 0U);
+  EXPECT_GT(r.quality.points_outliers, 0U);
+  EXPECT_TRUE(r.quality.icp_converged);
+  EXPECT_LT(r.quality.ground_tilt_deg, 5.0);
+  EXPECT_NEAR(r.quality.base_edge_centre.x(), plot.truth.ground_x_m, 0.02);
+}
+
+TEST(TraitsTruth, ShortPlotWithTwoMillimetreNoise) {
+  expectMatchesTruth(testSpec(1.2, 0.002, 21));
+}
+
+TEST(TraitsTruth, TallPlotWithFourMillimetreNoise) {
+  expectMatchesTruth(testSpec(2.6, 0.004, 22));
+}
+
+TEST(TraitsTruth, CameraFrameInputGivesThePlotFrameResult) {
+  const sim::PlotCloud plot = sim::generatePlot(testSpec(1.5, 0.003, 23));
+  const TraitsOptions options;
+  std::vector<Eigen::Vector3f> camera;
+  const Eigen::Matrix3f plot_to_camera = options.camera_to_plot.transpose().cast<float>();
+  for (const Eigen::Vector3f& p : plot.points)
+    camera.push_back(plot_to_camera * p);
+  const TraitsResult in_plot = computeTraits(plot.points, InputFrame::kPlot, options);
+  const TraitsResult in_camera = computeTraits(camera, InputFrame::kCamera, options);
+  ASSERT_EQ(in_camera.status, TraitsStatus::kOk) << in_camera.message;
+  EXPECT_NEAR(in_camera.height_m, in_plot.height_m, 1e-3);
+  EXPECT_NEAR(in_camera.width_m, in_plot.width_m, 1e-3);
+  EXPECT_NEAR(in_camera.vvi, in_plot.vvi, 1e-3);
+}
+
+TEST(TraitsTruth, TiltedGroundIsFoundByTheRegistration) {
+  sim::PlotSpec spec = testSpec(1.5, 0.003, 24);
+  spec.ground_tilt_deg = 4.0;
+  const sim::PlotCloud plot = sim::generatePlot(spec);
+  const TraitsResult r = computeTraits(plot.points, InputFrame::kPlot, TraitsOptions{});
+  ASSERT_EQ(r.status, TraitsStatus::kOk) << r.message;
+  EXPECT_NEAR(r.quality.ground_tilt_deg, 4.0, 1.5);
+  EXPECT_NEAR(r.height_m, plotTruth(plot, TraitsOptions{}).definitions.height_m, 0.03);
+}
+
+// Paper claim 1: the weighted median of per-slice maxima ignores a single abnormal tall plant.
+TEST(TraitsTruth, WeightedMedianIgnoresASingleTallPlant) {
+  sim::PlotSpec spec = testSpec(1.8, 0.003, 25);
+  const TraitsResult normal =
+      computeTraits(sim::generatePlot(spec).points, InputFrame::kPlot, TraitsOptions{});
+  spec.tall_plant = 4;
+  spec.tall_plant_factor = 1.4;
+  const sim::PlotCloud tall_plot = sim::generatePlot(spec);
+  const TraitsResult tall = computeTraits(tall_plot.points, InputFrame::kPlot, TraitsOptions{});
+  ASSERT_EQ(tall.status, TraitsStatus::kOk);
+  double highest = 0.0;
+  for (const SliceStats& s : tall.slices)
+    highest = std::max(highest, s.x_max - tall.x_min);
+  EXPECT_GT(highest, normal.height_m + 0.4);  // the tall plant is in the cloud...
+  // ...but hardly in the plot's height: its leaves arch over the neighbouring slices and lift
+  // them a little (the truth of the definitions moves the same way), its top does not count.
+  EXPECT_LT(tall.height_m - normal.height_m, 0.2 * (highest - normal.height_m));
+  EXPECT_NEAR(tall.height_m, plotTruth(tall_plot, TraitsOptions{}).definitions.height_m, 0.03);
+}
+
+// Paper claim 2: empty space (missing plants) does not lower VVI: invalid slices leave EGA.
+TEST(TraitsTruth, EmptySpaceDoesNotLowerVvi) {
+  sim::PlotSpec spec = testSpec(1.8, 0.003, 26);
+  const TraitsResult full =
+      computeTraits(sim::generatePlot(spec).points, InputFrame::kPlot, TraitsOptions{});
+  spec.missing_plants = {3, 4, 5};
+  const TraitsResult gappy =
+      computeTraits(sim::generatePlot(spec).points, InputFrame::kPlot, TraitsOptions{});
+  ASSERT_EQ(full.status, TraitsStatus::kOk);
+  ASSERT_EQ(gappy.status, TraitsStatus::kOk);
+  EXPECT_LT(gappy.quality.valid_slices, full.quality.valid_slices);
+  EXPECT_LT(gappy.ega_m2, full.ega_m2);
+  EXPECT_GT(gappy.vvi, 0.9 * full.vvi);
+  // Without the validity test (alpha = 0) the gap would count as plot: VVI drops.
+  TraitsOptions all_slices;
+  all_slices.alpha = 0.0;
+  sim::PlotSpec same = spec;
+  const TraitsResult naive =
+      computeTraits(sim::generatePlot(same).points, InputFrame::kPlot, all_slices);
+  EXPECT_LT(naive.vvi, gappy.vvi);
+}
+
+// How much the truth itself moves when the voxel grid is shifted by a fraction of a cell: the
+// accuracy figures of the bench are read against this.
+TEST(TraitsTruth, TruthIsStableUnderVoxelGridShifts) {
+  const sim::PlotCloud plot = sim::generatePlot(testSpec(2.0, 0.0, 27));
+  const TraitsOptions options;
+  const auto base = plotTruth(plot, options);
+  for (float f : {0.25F, 0.5F, 0.75F}) {
+    const auto shifted = plotTruth(plot, options, Eigen::Vector3f::Constant(f * 0.01F));
+    EXPECT_NEAR(shifted.definitions.height_m, base.definitions.height_m, 0.02);
+    EXPECT_NEAR(shifted.definitions.width_m, base.definitions.width_m, 0.03);
+    EXPECT_NEAR(shifted.definitions.vvi, base.definitions.vvi, 0.05 * base.definitions.vvi);
+  }
+}
+
+}  // namespace
+}  // namespace fieldrig::traits
