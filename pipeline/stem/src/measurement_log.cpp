@@ -1,0 +1,220 @@
+#include "fieldrig/stem/measurement_log.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace fieldrig::stem {
+namespace {
+
+constexpr int kColumns = 18;
+
+// RFC 4180 quoting: fields with a comma, quote or line break are quoted, quotes doubled.
+std::string quoted(const std::string& field) {
+  if (field.find_first_of(",\"\r\n") == std::string::npos)
+    return field;
+  std::string out = "\"";
+  for (char c : field) {
+    if (c == '"')
+      out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string number(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  return buffer;
+}
+
+bool splitCsvLine(const std::string& line, std::vector<std::string>& fields) {
+  fields.clear();
+  std::string field;
+  bool in_quotes = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (in_quotes) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        field += '"';
+        ++i;
+      } else if (c == '"') {
+        in_quotes = false;
+      } else {
+        field += c;
+      }
+    } else if (c == '"') {
+      in_quotes = true;
+    } else if (c == ',') {
+      fields.push_back(field);
+      field.clear();
+    } else if (c != '\r') {
+      field += c;
+    }
+  }
+  fields.push_back(field);
+  return !in_quotes;
+}
+
+bool parseDouble(const std::string& text, double& value) {
+  if (text.empty())
+    return false;
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtod(text.c_str(), &end);
+  return errno == 0 && end == text.c_str() + text.size() && std::isfinite(value);
+}
+
+bool parseUnsigned(const std::string& text, std::uint64_t& value) {
+  if (text.empty() || text[0] == '-')
+    return false;
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtoull(text.c_str(), &end, 10);
+  return errno == 0 && end == text.c_str() + text.size();
+}
+
+const char* const kHeaderNames[kColumns] = {
+    "session", "set_index",    "trigger_id", "head",        "stem_label", "x1",
+    "y1",      "x2",           "y2",         "x3",          "y3",         "x4",
+    "y4",      "disparity_px", "ncc",        "diameter_mm", "time",       "repeat"};
+
+}  // namespace
+
+std::string csvHeader() {
+  std::string header = kHeaderNames[0];
+  for (int i = 1; i < kColumns; ++i) {
+    header += ',';
+    header += kHeaderNames[i];
+  }
+  return header;
+}
+
+std::string toCsvRow(const MeasurementRecord& r) {
+  std::string row = quoted(r.session) + "," + std::to_string(r.set_index) + "," +
+                    std::to_string(r.trigger_id) + "," + quoted(r.head) + "," +
+                    quoted(r.stem_label);
+  for (const cv::Point2d& p : r.points)
+    row += "," + number(p.x, 2) + "," + number(p.y, 2);
+  row += "," + number(r.disparity_px, 3) + "," + number(r.ncc, 4) + "," + number(r.diameter_mm, 3) +
+         "," + quoted(r.time) + "," + std::to_string(r.repeat);
+  return row;
+}
+
+core::Result<std::vector<MeasurementRecord>> readMeasurementLog(const std::filesystem::path& file) {
+  std::vector<MeasurementRecord> records;
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec))
+    return records;
+  std::ifstream in(file);
+  if (!in)
+    return core::Error{file.string() + ": cannot be read"};
+  std::string line;
+  std::vector<std::string> fields;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty() || line == "\r")
+      continue;
+    const std::string where = file.string() + ":" + std::to_string(line_number) + ": ";
+    if (!splitCsvLine(line, fields))
+      return core::Error{where + "unterminated quoted field"};
+    if (line_number == 1 && !fields.empty() && fields[0] == "session")
+      continue;
+    if (fields.size() != static_cast<std::size_t>(kColumns)) {
+      return core::Error{where + std::to_string(fields.size()) + " fields, expected " +
+                         std::to_string(kColumns)};
+    }
+    MeasurementRecord r;
+    r.session = fields[0];
+    r.head = fields[3];
+    r.stem_label = fields[4];
+    r.time = fields[16];
+    std::uint64_t repeat = 0;
+    if (!parseUnsigned(fields[1], r.set_index))
+      return core::Error{where + "field 'set_index': not a count"};
+    if (!parseUnsigned(fields[2], r.trigger_id))
+      return core::Error{where + "field 'trigger_id': not a count"};
+    if (!parseUnsigned(fields[17], repeat))
+      return core::Error{where + "field 'repeat': not a count"};
+    r.repeat = static_cast<int>(repeat);
+    double values[11];
+    for (int i = 0; i < 11; ++i) {
+      const int column = i < 8 ? 5 + i : 13 + (i - 8);
+      if (!parseDouble(fields[static_cast<std::size_t>(column)], values[i])) {
+        return core::Error{where + "field '" + kHeaderNames[column] + "': not a number"};
+      }
+    }
+    for (std::size_t i = 0; i < 4; ++i)
+      r.points[i] = cv::Point2d(values[2 * i], values[2 * i + 1]);
+    r.disparity_px = values[8];
+    r.ncc = values[9];
+    r.diameter_mm = values[10];
+    records.push_back(std::move(r));
+  }
+  return records;
+}
+
+core::Result<bool> appendMeasurement(const std::filesystem::path& file,
+                                     const MeasurementRecord& record) {
+  std::error_code ec;
+  const bool fresh =
+      !std::filesystem::exists(file, ec) || std::filesystem::file_size(file, ec) == 0;
+  std::ofstream out(file, std::ios::app);
+  if (!out)
+    return core::Error{file.string() + ": cannot be opened for writing"};
+  if (fresh)
+    out << csvHeader() << '\n';
+  out << toCsvRow(record) << '\n';
+  out.flush();
+  if (!out)
+    return core::Error{file.string() + ": write failed"};
+  return true;
+}
+
+int nextRepeat(const std::vector<MeasurementRecord>& records, const std::string& session,
+               const std::string& stem_label) {
+  int highest = 0;
+  for (const MeasurementRecord& r : records) {
+    if (r.session == session && r.stem_label == stem_label)
+      highest = std::max(highest, r.repeat);
+  }
+  return highest + 1;
+}
+
+std::vector<StemSummary> summarizeRepeats(const std::vector<MeasurementRecord>& records) {
+  std::vector<StemSummary> summaries;
+  std::vector<std::vector<double>> values;
+  for (const MeasurementRecord& r : records) {
+    std::size_t i = 0;
+    while (i < summaries.size() &&
+           (summaries[i].session != r.session || summaries[i].stem_label != r.stem_label))
+      ++i;
+    if (i == summaries.size()) {
+      summaries.push_back({r.session, r.stem_label, 0, 0.0, 0.0});
+      values.emplace_back();
+    }
+    values[i].push_back(r.diameter_mm);
+  }
+  for (std::size_t i = 0; i < summaries.size(); ++i) {
+    const std::vector<double>& v = values[i];
+    double sum = 0.0;
+    for (double x : v)
+      sum += x;
+    const double mean = sum / static_cast<double>(v.size());
+    double squares = 0.0;
+    for (double x : v)
+      squares += (x - mean) * (x - mean);
+    summaries[i].count = static_cast<int>(v.size());
+    summaries[i].mean_mm = mean;
+    summaries[i].sd_mm =
+        v.size() > 1 ? std::sqrt(squares / static_cast<double>(v.size() - 1)) : 0.0;
+  }
+  return summaries;
+}
+
+}  // namespace fieldrig::stem

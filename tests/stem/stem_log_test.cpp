@@ -1,0 +1,88 @@
+// The CSV log of measurements: round trip (quoting included), repeat numbering, mean and SD of
+// repeats, and errors that name the file, line and field.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "fieldrig/stem/measurement_log.h"
+#include "support/temp_dir.h"
+
+namespace fieldrig::stem {
+namespace {
+
+MeasurementRecord record(const std::string& label, double diameter, int repeat) {
+  MeasurementRecord r;
+  r.session = "2026-07-01_plot, north";
+  r.set_index = 3;
+  r.trigger_id = 17;
+  r.head = "bottom";
+  r.stem_label = label;
+  r.points = {cv::Point2d(1.25, 2.5), cv::Point2d(3, 4), cv::Point2d(5, 6), cv::Point2d(7, 8.75)};
+  r.disparity_px = 161.234;
+  r.ncc = 0.9312;
+  r.diameter_mm = diameter;
+  r.time = "2026-07-01T12:00:00.000Z";
+  r.repeat = repeat;
+  return r;
+}
+
+TEST(StemLog, RoundTripsThroughTheCsvFile) {
+  testing_support::ScopedTempDir dir("stem_log_round_trip");
+  const auto file = dir / "stem.csv";
+  ASSERT_TRUE(appendMeasurement(file, record("row 4 \"tall\"", 14.5, 1)).ok());
+  ASSERT_TRUE(appendMeasurement(file, record("row 4 \"tall\"", 15.5, 2)).ok());
+  auto records = readMeasurementLog(file);
+  ASSERT_TRUE(records.ok()) << records.error().message;
+  ASSERT_EQ(records->size(), 2u);
+  const MeasurementRecord& r = (*records)[1];
+  EXPECT_EQ(r.session, "2026-07-01_plot, north");
+  EXPECT_EQ(r.stem_label, "row 4 \"tall\"");
+  EXPECT_EQ(r.set_index, 3u);
+  EXPECT_EQ(r.trigger_id, 17u);
+  EXPECT_EQ(r.head, "bottom");
+  EXPECT_DOUBLE_EQ(r.points[3].y, 8.75);
+  EXPECT_DOUBLE_EQ(r.disparity_px, 161.234);
+  EXPECT_DOUBLE_EQ(r.ncc, 0.9312);
+  EXPECT_DOUBLE_EQ(r.diameter_mm, 15.5);
+  EXPECT_EQ(r.repeat, 2);
+  EXPECT_EQ(r.time, "2026-07-01T12:00:00.000Z");
+  std::ifstream in(file);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, csvHeader());
+}
+
+TEST(StemLog, NumbersRepeatsPerStemAndSummarizesMeanAndSd) {
+  std::vector<MeasurementRecord> records{record("a", 10.0, 1), record("b", 20.0, 1),
+                                         record("a", 12.0, 2), record("a", 14.0, 3)};
+  EXPECT_EQ(nextRepeat(records, records[0].session, "a"), 4);
+  EXPECT_EQ(nextRepeat(records, records[0].session, "b"), 2);
+  EXPECT_EQ(nextRepeat(records, records[0].session, "c"), 1);
+  EXPECT_EQ(nextRepeat(records, "another session", "a"), 1);
+  const std::vector<StemSummary> summary = summarizeRepeats(records);
+  ASSERT_EQ(summary.size(), 2u);
+  EXPECT_EQ(summary[0].stem_label, "a");
+  EXPECT_EQ(summary[0].count, 3);
+  EXPECT_DOUBLE_EQ(summary[0].mean_mm, 12.0);
+  EXPECT_DOUBLE_EQ(summary[0].sd_mm, 2.0);  // sample SD of 10, 12, 14
+  EXPECT_EQ(summary[1].count, 1);
+  EXPECT_DOUBLE_EQ(summary[1].sd_mm, 0.0);
+}
+
+TEST(StemLog, AMissingFileIsAnEmptyLogAndABadFieldIsNamed) {
+  testing_support::ScopedTempDir dir("stem_log_errors");
+  auto empty = readMeasurementLog(dir / "absent.csv");
+  ASSERT_TRUE(empty.ok());
+  EXPECT_TRUE(empty->empty());
+  const auto file = dir / "bad.csv";
+  std::string row = toCsvRow(record("a", 10.0, 1));
+  row.replace(row.find("161.234"), 7, "sixteen");
+  std::ofstream(file) << csvHeader() << '\n' << row << '\n';
+  auto bad = readMeasurementLog(file);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().message.find("bad.csv:2:"), std::string::npos) << bad.error().message;
+  EXPECT_NE(bad.error().message.find("disparity_px"), std::string::npos) << bad.error().message;
+}
+
+}  // namespace
+}  // namespace fieldrig::stem
