@@ -137,10 +137,37 @@ TEST(CloudBuilder, WrongSizesFlagTheHead) {
   EXPECT_TRUE(result.heads[2].ok);
 }
 
+TEST(DepthEdges, BlendedPixelsAtAStepGoAndSlopesStay) {
+  // Left half a leaf at 60 px, right half the background at 10 px, with SGBM's blend of the two
+  // in the columns between; the rows below are a slanted surface (0.5 px per column).
+  cv::Mat disparity(20, 40, CV_32F, cv::Scalar(stereo::kInvalidDisparity));
+  for (int x = 0; x < 40; ++x) {
+    for (int y = 0; y < 10; ++y)
+      disparity.at<float>(y, x) = x < 18 ? 60.0F : (x < 22 ? 60.0F - 12.5F * (x - 17) : 10.0F);
+    for (int y = 10; y < 20; ++y)
+      disparity.at<float>(y, x) = 30.0F + 0.5F * static_cast<float>(x);
+  }
+  disparity.at<float>(15, 5) = stereo::kInvalidDisparity;  // a hole must not make edges around it
+  const std::size_t dropped = dropDepthEdges(disparity, 2.0);
+  for (int y = 0; y < 9; ++y) {  // row 9 borders the slope: its pixels see the rows below
+    for (int x = 17; x <= 21; ++x)
+      EXPECT_EQ(disparity.at<float>(y, x), stereo::kInvalidDisparity) << x << "," << y;
+    EXPECT_EQ(disparity.at<float>(y, 10), 60.0F);
+    EXPECT_EQ(disparity.at<float>(y, 30), 10.0F);
+  }
+  for (int x = 0; x < 40; ++x) {
+    if (x != 5) {
+      EXPECT_GT(disparity.at<float>(15, x), 0.0F) << "the slope is no edge, column " << x;
+    }
+  }
+  EXPECT_GE(dropped, 5U * 9U);
+}
+
 TEST(Rig, SaveLoadRoundTrip) {
   ScopedTempDir dir("cloud_rig_round_trip");
   RigConfig rig = syntheticRig();
   rig.max_depth_m = 1.5;
+  rig.edge_max_jump_px = 3.5;
   rig.pixel_format = core::PixelFormat::kBayerGB8;
   ASSERT_TRUE(saveRig(rig, dir.path()));
   auto loaded = loadRig(dir.path());
@@ -150,6 +177,7 @@ TEST(Rig, SaveLoadRoundTrip) {
   EXPECT_LT(cv::norm(loaded->heads[2].to_bottom - rig.heads[2].to_bottom), 1e-12);
   EXPECT_EQ(loaded->heads[1].calibration.image_size, kCameraSize);
   EXPECT_DOUBLE_EQ(loaded->max_depth_m, 1.5);
+  EXPECT_DOUBLE_EQ(loaded->edge_max_jump_px, 3.5);
   EXPECT_EQ(loaded->pixel_format, core::PixelFormat::kBayerGB8);
   EXPECT_LT(cv::norm(cv::Mat(loaded->plot_rotation), cv::Mat(rig.plot_rotation)), 1e-12);
 }

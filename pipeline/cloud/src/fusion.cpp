@@ -3,7 +3,9 @@
 #include <pcl/io/ply_io.h>
 
 #include <chrono>
+#include <limits>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 namespace fieldrig::cloud {
 namespace {
@@ -76,6 +78,23 @@ std::size_t appendReprojected(const cv::Mat& disparity, const cv::Mat& left_bgr,
   return out.size() - before;
 }
 
+std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump) {
+  CV_Assert(disparity.type() == CV_32F);
+  // Neighbourhood maximum and minimum by grey dilation and erosion; invalid pixels must not
+  // count, so they are below every disparity for the maximum and above for the minimum.
+  const cv::Mat invalid = ~(disparity > 0);
+  cv::Mat for_min = disparity.clone();
+  for_min.setTo(std::numeric_limits<float>::max(), invalid);
+  cv::Mat highest, lowest;
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+  cv::dilate(disparity, highest, kernel);
+  cv::erode(for_min, lowest, kernel);
+  const cv::Mat edge = (highest - lowest > max_jump) & ~invalid;
+  const auto dropped = static_cast<std::size_t>(cv::countNonZero(edge));
+  disparity.setTo(stereo::kInvalidDisparity, edge);
+  return dropped;
+}
+
 core::Result<CloudBuilder> CloudBuilder::create(const RigConfig& rig,
                                                 stereo::MatcherOptions matcher) {
   if (rig.heads.empty()) {
@@ -124,6 +143,8 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
         status.problem = output.error().message;
         return;
       }
+      if (rig_.edge_max_jump_px > 0)
+        status.edge_pixels = dropDepthEdges(output->disparity, rig_.edge_max_jump_px);
       status.points = appendReprojected(
           output->disparity, output->left_bgr, heads_[i].matchingCalibration().Q, to_plot_[i],
           rig_.min_depth_m, rig_.max_depth_m, head_clouds[i], &status.reproject_ms);

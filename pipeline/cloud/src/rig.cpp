@@ -103,10 +103,11 @@ core::Result<RigConfig> loadRig(const fs::path& directory) {
   double min_disparity = rig.min_disparity;
   if (!readNumber("max_depth_m", rig.max_depth_m) || !readNumber("min_depth_m", rig.min_depth_m) ||
       !readNumber("scale", rig.scale) || !readNumber("num_disparities", num_disparities) ||
-      !readNumber("min_disparity", min_disparity)) {
+      !readNumber("min_disparity", min_disparity) ||
+      !readNumber("edge_max_jump_px", rig.edge_max_jump_px)) {
     return Error{file.string() +
                  ": one of 'max_depth_m', 'min_depth_m', 'scale', 'num_disparities', "
-                 "'min_disparity' is not a number"};
+                 "'min_disparity', 'edge_max_jump_px' is not a number"};
   }
   rig.num_disparities = static_cast<int>(num_disparities);
   rig.min_disparity = static_cast<int>(min_disparity);
@@ -155,7 +156,8 @@ core::Result<fs::path> saveRig(const RigConfig& rig, const fs::path& directory) 
     storage << "plot_rotation" << cv::Mat(rig.plot_rotation) << "max_depth_m" << rig.max_depth_m
             << "min_depth_m" << rig.min_depth_m << "pixel_format"
             << std::string(core::toString(rig.pixel_format)) << "scale" << rig.scale
-            << "min_disparity" << rig.min_disparity << "num_disparities" << rig.num_disparities;
+            << "min_disparity" << rig.min_disparity << "num_disparities" << rig.num_disparities
+            << "edge_max_jump_px" << rig.edge_max_jump_px;
   } catch (const cv::Exception& e) {
     return Error{file.string() + ": cannot write: " + e.what()};
   }

@@ -31,6 +31,7 @@ struct HeadStatus {
   bool ok = false;
   std::string problem;  // why the head was left out, when not ok
   std::size_t points = 0;
+  std::size_t edge_pixels = 0;  // dropped as depth edges (dropDepthEdges)
   stereo::HeadTimings timings;
   double reproject_ms = 0;  // reprojection, transform into the plot frame, crop, colour
 };
@@ -48,6 +49,11 @@ struct FusionResult {
 std::size_t appendReprojected(const cv::Mat& disparity, const cv::Mat& left_bgr, const cv::Mat& Q,
                               const cv::Matx44d& to_output, double min_z, double max_z, Cloud& out,
                               double* reproject_ms = nullptr);
+
+// Marks as invalid (stereo::kInvalidDisparity) every pixel of `disparity` (CV_32F) whose valid
+// 3×3 neighbours, itself included, differ by more than `max_jump` pixels of disparity. Returns how
+// many pixels it invalidated.
+std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump);
 
 // Thread contract: thread-compatible; one instance per thread.
 class CloudBuilder {

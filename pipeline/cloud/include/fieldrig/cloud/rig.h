@@ -38,6 +38,10 @@ struct RigConfig {
   // and B = 0.12 m at 812×612, 0.8–1.7 m plants are 101–48 px.
   int min_disparity = 0;
   int num_disparities = 128;
+  // Pixels on a depth edge — whose 3×3 neighbourhood spans more than this many pixels of
+  // disparity — are not reprojected: SGBM blends foreground and background there, and the
+  // blend lands as "flying" points between a leaf and what is behind it. 0 keeps them.
+  double edge_max_jump_px = 2.0;
 };
 
 // Reads DIR/rig.yml and each head's DIR/<name>/{intrinsics,extrinsics}.yml. The error names the
