@@ -19,6 +19,10 @@ int main(int argc, char** argv) {
   fieldrig::tools::registerSimCommand(app, exit_code);
   fieldrig::tools::registerAcquireCommand(app, exit_code);
   fieldrig::tools::registerSessionCommand(app, exit_code);
+  fieldrig::tools::registerStereoCommands(app, exit_code);
+  fieldrig::tools::registerTraitsCommand(app, exit_code);
+  fieldrig::tools::registerStemCommands(app, exit_code);
+  fieldrig::tools::registerProcessCommand(app, exit_code);
   CLI11_PARSE(app, argc, argv);
   return exit_code;
 }

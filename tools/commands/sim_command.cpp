@@ -95,6 +95,7 @@ void registerSimCommand(CLI::App& app, int& exit_code) {
   drive->add_option("--out-nmea", args->out_nmea, "NMEA file to write")->required();
   drive->add_option("--out-map", args->out_map, "Location map to write")->required();
   drive->callback([args, &exit_code] { exit_code = runDrive(*args); });
+  registerSimPlotsSubcommand(*sim, exit_code);
 }
 
 }  // namespace fieldrig::tools

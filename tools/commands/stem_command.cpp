@@ -1,0 +1,93 @@
+// `fieldrig stem`: the four-click stem diameter of one stereo pair, from the command line.
+//   fieldrig stem --left L --right R --intrinsics I.yml --extrinsics E.yml
+//                 --points x1,y1,x2,y2,x3,y3,x4,y4 [--json] [--bayer RG|GR|GB|BG]
+// Points are pixels of the raw left image, any order. Exit codes: 0 measured; 2 bad input
+// (files, calibration, points that are not a convex quadrangle); 3 no reliable measurement
+// (weak NCC match, no disparity range in the image).
+// `fieldrig stem-ui` (the browser tool) is registered from stem_ui_server.cpp.
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "commands/commands.h"
+#include "commands/stem_support.h"
+#include "fieldrig/stem/stem_measurer.h"
+
+namespace fieldrig::tools {
+namespace {
+
+struct StemArgs {
+  std::string left, right, intrinsics, extrinsics, points, bayer;
+  bool json = false;
+  bool face_value = false;
+  bool plane = false;
+};
+
+int runStem(const StemArgs& args) {
+  const auto fail = [](const std::string& message) {
+    std::cerr << "fieldrig stem: " << message << '\n';
+    return kExitBadInput;
+  };
+  core::Result<stem::Points4> points = parseStemPoints(args.points);
+  if (!points)
+    return fail("--points: " + points.error().message);
+  core::Result<stereo::StereoCalibration> calibration =
+      stereo::loadStereoCalibration(args.intrinsics, args.extrinsics);
+  if (!calibration)
+    return fail(calibration.error().message);
+  core::Result<cv::Mat> left = loadGreyImage(args.left, args.bayer);
+  if (!left)
+    return fail(left.error().message);
+  core::Result<cv::Mat> right = loadGreyImage(args.right, args.bayer);
+  if (!right)
+    return fail(right.error().message);
+  core::Result<stem::StemMeasurer> measurer =
+      stem::StemMeasurer::create(*calibration, *left, *right);
+  if (!measurer)
+    return fail(measurer.error().message);
+  stem::MeasureOptions options;
+  options.refine_edges = !args.face_value;
+  options.cylinder_model = !args.plane;
+  const stem::StemMeasurement m = measurer->measure(*points, options);
+  if (args.json) {
+    std::cout << measurementJson(m).dump() << '\n';
+  } else if (m.ok()) {
+    std::cout << "diameter " << m.diameter_mm << " mm  (disparity " << m.disparity_px << " px, NCC "
+              << m.ncc << ", width " << m.width.d << " px)\n";
+  }
+  if (m.ok())
+    return kExitOk;
+  std::cerr << "fieldrig stem: " << m.message << '\n';
+  return m.status == stem::MeasureStatus::kBadPoints ? kExitBadInput : kExitRuntime;
+}
+
+}  // namespace
+
+void registerStemCommands(CLI::App& app, int& exit_code) {
+  CLI::App* command = app.add_subcommand(
+      "stem", "Stem diameter from four clicks on its edges in the raw left image of a stereo pair");
+  auto args = std::make_shared<StemArgs>();
+  command->add_option("--left", args->left, "Left image (raw, as recorded)")->required();
+  command->add_option("--right", args->right, "Right image (raw, as recorded)")->required();
+  command->add_option("--intrinsics", args->intrinsics, "intrinsics.yml (M1 D1 M2 D2)")->required();
+  command->add_option("--extrinsics", args->extrinsics, "extrinsics.yml (R T R1 R2 P1 P2 Q)")
+      ->required();
+  command
+      ->add_option("--points", args->points,
+                   "x1,y1,x2,y2,x3,y3,x4,y4: two points on each stem edge, any order")
+      ->required();
+  command->add_option("--bayer", args->bayer,
+                      "The images are raw Bayer with this first row pattern (RG, GR, GB, BG)");
+  command->add_flag("--json", args->json, "Print one JSON object");
+  command->add_flag("--face-value", args->face_value,
+                    "Take the clicks as the edges (no sub-pixel edge search), as the paper did");
+  command->add_flag("--plane", args->plane,
+                    "Diameter by eq. 13 (fronto-parallel patch) instead of the cylinder model");
+  command->callback([args, &exit_code] { exit_code = runStem(*args); });
+  registerStemUiCommand(app, exit_code);
+}
+
+}  // namespace fieldrig::tools

@@ -1,0 +1,215 @@
+// `fieldrig traits --cloud FILE [--frame plot|camera] [--config FILE] [--area depth_map|paper]
+// --json`: the traits of one plot cloud as one JSON object.
+// `fieldrig traits synth --out plot.ply [--truth truth.json] ...`: a synthetic row plot with its
+// truth (the trait definitions on the noise-free visible geometry, the visible surface area).
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands/commands.h"
+#include "fieldrig/sim/plot_generator.h"
+#include "fieldrig/traits/cloud_io.h"
+#include "fieldrig/traits/plot_report.h"
+#include "fieldrig/traits/plot_traits.h"
+#include "fieldrig/traits/traits_config.h"
+
+namespace fieldrig::tools {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+struct TraitsArgs {
+  std::string cloud;
+  std::string frame = "plot";
+  std::string config;
+  std::string area;
+  bool json = false;
+};
+
+struct SynthArgs {
+  std::string out;
+  std::string truth;
+  std::string frame = "plot";
+  double height = 2.0;
+  double noise = 0.003;
+  double row_length = 1.5;
+  int tall_plant = -1;
+  std::vector<int> missing;
+  std::uint32_t seed = 1;
+  std::size_t points = 0;
+  bool no_plants = false;
+};
+
+int runTraits(const TraitsArgs& args) {
+  traits::TraitsOptions options;
+  if (!args.config.empty()) {
+    core::Result<traits::TraitsOptions> loaded = traits::loadTraitsOptions(args.config);
+    if (!loaded) {
+      std::cerr << "fieldrig traits: " << loaded.error().message << '\n';
+      return kExitBadInput;
+    }
+    options = *loaded;
+  }
+  if (args.area == "paper")
+    options.area_method = traits::AreaMethod::kPaperMlsGpt;
+  else if (args.area == "depth_map")
+    options.area_method = traits::AreaMethod::kDepthMap;
+  core::Result<std::vector<Eigen::Vector3f>> cloud = traits::loadCloud(args.cloud);
+  if (!cloud) {
+    std::cerr << "fieldrig traits: " << cloud.error().message << '\n';
+    return kExitBadInput;
+  }
+  const traits::InputFrame frame =
+      args.frame == "camera" ? traits::InputFrame::kCamera : traits::InputFrame::kPlot;
+  const traits::TraitsResult result = traits::computeTraits(*cloud, frame, options);
+  Json out = traits::traitsToJson(result);
+  out["cloud"] = args.cloud;
+  out["frame"] = args.frame;
+  if (args.json) {
+    std::cout << out.dump() << '\n';
+  } else {
+    std::cout << "status " << out["status"].get<std::string>() << '\n';
+    for (const char* key :
+         {"height_m", "width_m", "vvi", "vai", "total_volume_m3", "total_area_m2", "ega_m2"})
+      std::cout << key << ' ' << out[key].dump() << '\n';
+    if (!result.message.empty())
+      std::cout << "message " << result.message << '\n';
+  }
+  // Bad data is a result with a status, not a failure of the tool: exit 0 unless input unusable.
+  return kExitOk;
+}
+
+// The trait definitions on the generator's noise-free visible plant geometry (after the same
+// depth crop and 1 cm voxel grid as the pipeline), as tests/traits/plot_truth.h does for tests.
+Json truthJson(const sim::PlotCloud& plot, const traits::TraitsOptions& options) {
+  std::vector<Eigen::Vector3f> clean;
+  for (const sim::PlotSample& s : plot.truth.visible_plant_samples) {
+    if (s.position.z() >= options.crop_z_min_m && s.position.z() <= options.crop_z_max_m)
+      clean.push_back(s.position);
+  }
+  traits::TraitsOptions no_area = options;
+  no_area.area_method = traits::AreaMethod::kNone;
+  const traits::TraitsResult d = traits::traitsFromPlantPoints(
+      traits::voxelDownsample(clean, options.voxel_leaf_m, Eigen::Vector3f::Zero()),
+      plot.truth.ground_x_m, no_area);
+  double area = 0.0;
+  for (const sim::PlotSample& s : plot.truth.visible_plant_samples) {
+    const Eigen::Vector3f& p = s.position;
+    if (p.z() >= options.crop_z_min_m && p.z() <= options.crop_z_max_m && p.x() >= d.x_min &&
+        p.x() <= d.x_max && p.z() >= d.z_min && p.z() <= d.z_max)
+      area += s.area_m2;
+  }
+  Json truth;
+  truth["status"] = traits::statusName(d.status);
+  truth["height_m"] = d.height_m;
+  truth["width_m"] = d.width_m;
+  truth["vvi"] = d.vvi;
+  truth["ega_m2"] = d.ega_m2;
+  truth["total_volume_m3"] = d.total_volume_m3;
+  truth["visible_area_in_box_m2"] = area;
+  truth["vai"] = d.ega_m2 > 0.0 ? area / d.ega_m2 : 0.0;
+  truth["ground_x_m"] = plot.truth.ground_x_m;
+  truth["base_depth_m"] = plot.truth.base_depth_m;
+  truth["visible_plant_area_m2"] = plot.truth.visible_plant_area_m2;
+  truth["total_plant_area_m2"] = plot.truth.total_plant_area_m2;
+  truth["plant_y_m"] = plot.truth.plant_y_m;
+  truth["plant_height_m"] = plot.truth.plant_height_m;
+  return truth;
+}
+
+int runSynth(const SynthArgs& args) {
+  sim::PlotSpec spec;
+  spec.plant_height_m = args.height;
+  spec.depth_noise_m = args.noise;
+  spec.row_length_m = args.row_length;
+  spec.tall_plant = args.tall_plant;
+  spec.missing_plants = args.missing;
+  spec.seed = args.seed;
+  spec.plants = !args.no_plants;
+  sim::PlotCloud plot = sim::generatePlot(spec);
+  if (args.points > 0)
+    sim::subsamplePlot(plot, args.points, args.seed);
+  std::vector<Eigen::Vector3f> points = plot.points;
+  if (args.frame == "camera") {
+    const Eigen::Matrix3f plot_to_camera =
+        traits::TraitsOptions{}.camera_to_plot.transpose().cast<float>();
+    for (Eigen::Vector3f& p : points)
+      p = plot_to_camera * p;
+  }
+  core::Result<bool> saved = traits::saveCloudPly(args.out, points, plot.colors);
+  if (!saved) {
+    std::cerr << "fieldrig traits synth: " << saved.error().message << '\n';
+    return kExitBadInput;
+  }
+  if (!args.truth.empty()) {
+    Json truth = truthJson(plot, traits::TraitsOptions{});
+    truth["points"] = points.size();
+    truth["frame"] = args.frame;
+    core::Result<bool> written = traits::writeText(args.truth, truth.dump(1) + "\n");
+    if (!written) {
+      std::cerr << "fieldrig traits synth: " << written.error().message << '\n';
+      return kExitBadInput;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void registerTraitsCommand(CLI::App& app, int& exit_code) {
+  CLI::App* traits_app =
+      app.add_subcommand("traits", "Plot traits (height, width, VVI, VAI) of one plot cloud");
+  traits_app->require_subcommand(0, 1);
+  auto args = std::make_shared<TraitsArgs>();
+  traits_app->add_option("--cloud", args->cloud, "Plot cloud (.ply or .pcd), metres")
+      ->check(CLI::ExistingFile);
+  traits_app->add_option("--frame", args->frame, "plot (x up, y row, z depth) or camera")
+      ->check(CLI::IsMember({"plot", "camera"}))
+      ->capture_default_str();
+  traits_app->add_option("--config", args->config, "Traits options (JSON)")
+      ->check(CLI::ExistingFile);
+  traits_app->add_option("--area", args->area, "Surface for VAI: depth_map (default) or paper")
+      ->check(CLI::IsMember({"depth_map", "paper"}));
+  traits_app->add_flag("--json", args->json, "Print one JSON object");
+
+  CLI::App* synth = traits_app->add_subcommand(
+      "synth", "Write a synthetic row plot (binary PLY) and its truth (JSON)");
+  auto synth_args = std::make_shared<SynthArgs>();
+  synth->add_option("--out", synth_args->out, "Output cloud (.ply)")->required();
+  synth->add_option("--truth", synth_args->truth, "Output truth (.json)");
+  synth->add_option("--frame", synth_args->frame, "plot or camera")
+      ->check(CLI::IsMember({"plot", "camera"}))
+      ->capture_default_str();
+  synth->add_option("--height", synth_args->height, "Plant height, m")
+      ->check(CLI::Range(0.2, 5.0))
+      ->capture_default_str();
+  synth->add_option("--noise", synth_args->noise, "Depth noise sigma, m")
+      ->check(CLI::Range(0.0, 0.05))
+      ->capture_default_str();
+  synth->add_option("--row-length", synth_args->row_length, "Imaged row length, m")
+      ->check(CLI::Range(0.1, 10.0))
+      ->capture_default_str();
+  synth->add_option("--tall-plant", synth_args->tall_plant, "Index of one abnormal tall plant");
+  synth->add_option("--missing", synth_args->missing, "Indices of missing plants");
+  synth->add_option("--seed", synth_args->seed, "Random seed")->capture_default_str();
+  synth->add_option("--points", synth_args->points, "Keep this many points (random)");
+  synth->add_flag("--no-plants", synth_args->no_plants, "Soil only");
+  synth->callback([synth_args, &exit_code] { exit_code = runSynth(*synth_args); });
+
+  traits_app->callback([traits_app, synth, args, &exit_code] {
+    if (synth->parsed())
+      return;
+    if (args->cloud.empty()) {
+      std::cerr << "fieldrig traits: --cloud FILE is required\n" << traits_app->help();
+      exit_code = kExitBadInput;
+      return;
+    }
+    exit_code = runTraits(*args);
+  });
+}
+
+}  // namespace fieldrig::tools
