@@ -24,18 +24,7 @@ inline constexpr double kBackgroundDepthM = 2.4;
 inline constexpr int kNearRows = 1224 * 2 / 3;  // of kCameraSize.height
 
 inline stereo::StereoCalibration idealHead() {
-  stereo::StereoCalibration c;
-  c.image_size = kCameraSize;
-  c.M1 = (cv::Mat_<double>(3, 3) << kFocalPx, 0, (kCameraSize.width - 1) / 2.0, 0, kFocalPx,
-          (kCameraSize.height - 1) / 2.0, 0, 0, 1);
-  c.M2 = c.M1.clone();
-  c.D1 = cv::Mat::zeros(1, 5, CV_64F);
-  c.D2 = c.D1.clone();
-  c.R = cv::Mat::eye(3, 3, CV_64F);
-  c.T = (cv::Mat_<double>(3, 1) << -kBaselineM, 0, 0);
-  cv::stereoRectify(c.M1, c.D1, c.M2, c.D2, kCameraSize, c.R, c.T, c.R1, c.R2, c.P1, c.P2, c.Q,
-                    cv::CALIB_ZERO_DISPARITY, 0);
-  return c;
+  return stereo::idealStereoCalibration(kFocalPx, kCameraSize, kBaselineM);
 }
 
 // bottom: reference; middle: 0.5 m above; top: 1.0 m above and tilted 20° down about x.

@@ -51,13 +51,7 @@ int runProcess(const ProcessArgs& args) {
     return kExitBadInput;
   }
   const recording::SessionReader& reader = *opened;
-  const auto calib_dir = sessionCalibrationDir(args.calib, reader);
-  if (!calib_dir) {
-    std::cerr << who << "no calibration: give --calib DIR (or record the session with a "
-              << "calibration reference named calib_dir)\n";
-    return kExitBadInput;
-  }
-  auto rig = cloud::loadRig(*calib_dir);
+  auto rig = loadRigFor(args.calib, &reader);
   if (!rig) {
     std::cerr << who << rig.error().message << '\n';
     return kExitBadInput;

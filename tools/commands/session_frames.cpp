@@ -55,4 +55,20 @@ std::optional<std::filesystem::path> sessionCalibrationDir(const std::string& ex
   return std::nullopt;
 }
 
+core::Result<cloud::RigConfig> loadRigFor(const std::string& explicit_dir,
+                                          const recording::SessionReader* reader) {
+  std::optional<std::filesystem::path> dir;
+  if (reader) {
+    dir = sessionCalibrationDir(explicit_dir, *reader);
+  } else if (!explicit_dir.empty()) {
+    dir = std::filesystem::path(explicit_dir);
+  }
+  if (!dir) {
+    return core::Error{
+        "no calibration: give --calib DIR (or record the session with a "
+        "calibration reference named calib_dir)"};
+  }
+  return cloud::loadRig(*dir);
+}
+
 }  // namespace fieldrig::tools

@@ -26,4 +26,9 @@ core::Result<std::vector<cloud::HeadFrames>> framesFromSession(
 std::optional<std::filesystem::path> sessionCalibrationDir(const std::string& explicit_dir,
                                                            const recording::SessionReader& reader);
 
+// The rig of `explicit_dir`, else of the session's calib_dir reference (`reader` may be null when
+// the frames come from image files). The error says what to give, or names the file and field.
+core::Result<cloud::RigConfig> loadRigFor(const std::string& explicit_dir,
+                                          const recording::SessionReader* reader);
+
 }  // namespace fieldrig::tools

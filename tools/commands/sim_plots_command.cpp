@@ -10,13 +10,13 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <opencv2/calib3d.hpp>
 
 #include "commands/commands.h"
 #include "fieldrig/cloud/rig.h"
 #include "fieldrig/recording/session_writer.h"
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/sim/plot_view_renderer.h"
+#include "fieldrig/stereo/calibration.h"
 #include "fieldrig/stereo/preprocess.h"
 #include "fieldrig/traits/plot_traits.h"
 
@@ -42,27 +42,12 @@ struct PlotsArgs {
   double height_max_m = 2.4;
 };
 
-stereo::StereoCalibration idealHeadCalibration() {
-  stereo::StereoCalibration c;
-  c.image_size = kCameraSize;
-  c.M1 = (cv::Mat_<double>(3, 3) << kFocalPx, 0, (kCameraSize.width - 1) / 2.0, 0, kFocalPx,
-          (kCameraSize.height - 1) / 2.0, 0, 0, 1);
-  c.M2 = c.M1.clone();
-  c.D1 = cv::Mat::zeros(1, 5, CV_64F);
-  c.D2 = c.D1.clone();
-  c.R = cv::Mat::eye(3, 3, CV_64F);
-  c.T = (cv::Mat_<double>(3, 1) << -kBaselineM, 0, 0);
-  cv::stereoRectify(c.M1, c.D1, c.M2, c.D2, kCameraSize, c.R, c.T, c.R1, c.R2, c.P1, c.P2, c.Q,
-                    cv::CALIB_ZERO_DISPARITY, 0);
-  return c;
-}
-
 cloud::RigConfig idealRig() {
   cloud::RigConfig rig;
   for (std::size_t i = 0; i < kHeadNames.size(); ++i) {
     cloud::HeadConfig head;
     head.name = kHeadNames[i];
-    head.calibration = idealHeadCalibration();
+    head.calibration = stereo::idealStereoCalibration(kFocalPx, kCameraSize, kBaselineM);
     // Head frame → bottom head's frame: straight above it, and camera y points down.
     head.to_bottom(1, 3) = -(kHeadHeightM[i] - kHeadHeightM[0]);
     rig.heads.push_back(std::move(head));

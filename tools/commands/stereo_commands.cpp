@@ -349,18 +349,7 @@ int runCloud(const CloudArgs& args) {
     }
     reader = std::move(*opened);
   }
-  std::optional<fs::path> calib_dir;
-  if (reader) {
-    calib_dir = sessionCalibrationDir(args.calib, *reader);
-  } else if (!args.calib.empty()) {
-    calib_dir = fs::path(args.calib);
-  }
-  if (!calib_dir) {
-    std::cerr << who << "no calibration: give --calib DIR (or record the session with a "
-              << "calibration reference named calib_dir)\n";
-    return kExitBadInput;
-  }
-  auto rig = cloud::loadRig(*calib_dir);
+  auto rig = loadRigFor(args.calib, reader ? &*reader : nullptr);
   if (!rig) {
     std::cerr << who << rig.error().message << '\n';
     return kExitBadInput;
@@ -378,7 +367,7 @@ int runCloud(const CloudArgs& args) {
     const std::vector<std::string> files = splitCommas(args.pairs);
     if (files.size() != 2 * rig->heads.size()) {
       std::cerr << who << "--pairs names " << files.size() << " files; the rig in "
-                << (*calib_dir / "rig.yml").string() << " has " << rig->heads.size()
+                << (fs::path(args.calib) / "rig.yml").string() << " has " << rig->heads.size()
                 << " heads, so " << 2 * rig->heads.size() << " are needed (L1,R1,L2,R2,…)\n";
       return kExitBadInput;
     }

@@ -84,6 +84,21 @@ StereoCalibration StereoCalibration::scaled(double factor) const {
   return out;
 }
 
+StereoCalibration idealStereoCalibration(double focal_px, cv::Size image_size, double baseline_m) {
+  StereoCalibration c;
+  c.image_size = image_size;
+  c.M1 = (cv::Mat_<double>(3, 3) << focal_px, 0, (image_size.width - 1) / 2.0, 0, focal_px,
+          (image_size.height - 1) / 2.0, 0, 0, 1);
+  c.M2 = c.M1.clone();
+  c.D1 = cv::Mat::zeros(1, 5, CV_64F);
+  c.D2 = c.D1.clone();
+  c.R = cv::Mat::eye(3, 3, CV_64F);
+  c.T = (cv::Mat_<double>(3, 1) << -baseline_m, 0, 0);
+  cv::stereoRectify(c.M1, c.D1, c.M2, c.D2, image_size, c.R, c.T, c.R1, c.R2, c.P1, c.P2, c.Q,
+                    cv::CALIB_ZERO_DISPARITY, 0);
+  return c;
+}
+
 core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::path& intrinsics,
                                                       const std::filesystem::path& extrinsics) {
   StereoCalibration calibration;

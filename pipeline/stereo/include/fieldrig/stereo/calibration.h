@@ -29,6 +29,11 @@ struct StereoCalibration {
   StereoCalibration scaled(double factor) const;
 };
 
+// A distortion-free pair of identical pinhole cameras (principal point at the image centre), the
+// right one `baseline_m` along the left one's x, rectified with stereoRectify: the calibration of
+// rendered scenes and synthetic rigs.
+StereoCalibration idealStereoCalibration(double focal_px, cv::Size image_size, double baseline_m);
+
 // Reads the two files; the error names the file and the missing or malformed field.
 core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::path& intrinsics,
                                                       const std::filesystem::path& extrinsics);
