@@ -12,15 +12,15 @@
 #include <vector>
 
 #include "fieldrig/sim/plot_generator.h"
+#include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/traits/plot_traits.h"
-#include "traits/plot_truth.h"
 
 namespace {
 
 using fieldrig::sim::PlotCloud;
 using fieldrig::sim::PlotSpec;
-using fieldrig::testing_support::plotTruth;
-using fieldrig::testing_support::PlotTruthTraits;
+using fieldrig::sim::plotTruth;
+using fieldrig::sim::PlotTruthTraits;
 namespace traits = fieldrig::traits;
 
 struct Case {

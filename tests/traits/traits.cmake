@@ -8,7 +8,7 @@ fieldrig_add_test(traits_math_test
 fieldrig_add_test(traits_truth_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/traits_truth_test.cpp
           ${CMAKE_CURRENT_LIST_DIR}/traits_bad_input_test.cpp
-  LIBS fieldrig::traits fieldrig::sim_plots
+  LIBS fieldrig::traits fieldrig::sim_plot_truth
   LABELS traits)
 fieldrig_add_test(traits_cli_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/traits_cli_test.cpp

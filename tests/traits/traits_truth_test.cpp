@@ -5,13 +5,13 @@
 #include <cmath>
 
 #include "fieldrig/sim/plot_generator.h"
+#include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/traits/plot_traits.h"
-#include "traits/plot_truth.h"
 
 namespace fieldrig::traits {
 namespace {
 
-using testing_support::plotTruth;
+using sim::plotTruth;
 
 sim::PlotSpec testSpec(double height, double noise, std::uint32_t seed) {
   sim::PlotSpec spec;

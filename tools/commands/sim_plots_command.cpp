@@ -15,10 +15,10 @@
 #include "fieldrig/cloud/rig.h"
 #include "fieldrig/recording/session_writer.h"
 #include "fieldrig/sim/plot_generator.h"
+#include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/sim/plot_view_renderer.h"
 #include "fieldrig/stereo/calibration.h"
 #include "fieldrig/stereo/preprocess.h"
-#include "fieldrig/traits/plot_traits.h"
 
 namespace fieldrig::tools {
 namespace {
@@ -142,17 +142,7 @@ int runPlots(const PlotsArgs& args) {
       std::cerr << who << written.message << '\n';
       return kExitRuntime;
     }
-    // Truth: the trait definitions on the visible, noise-free plant surfaces, cropped at the
-    // depth the pipeline crops (leaves reaching past it into the next row's space do not count).
-    const traits::TraitsOptions options;
-    std::vector<Eigen::Vector3f> plant_points;
-    plant_points.reserve(plot.truth.visible_plant_samples.size());
-    for (const sim::PlotSample& sample : plot.truth.visible_plant_samples) {
-      if (sample.position.z() <= options.crop_z_max_m)
-        plant_points.push_back(sample.position);
-    }
-    const traits::TraitsResult truth =
-        traits::traitsFromPlantPoints(plant_points, plot.truth.ground_x_m, options);
+    const traits::TraitsResult truth = sim::plotTruth(plot, traits::TraitsOptions{}).definitions;
     Json line;
     line["plot"] = *record.location_id;
     line["set"] = written.set_index;

@@ -12,6 +12,7 @@
 
 #include "commands/commands.h"
 #include "fieldrig/sim/plot_generator.h"
+#include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/traits/cloud_io.h"
 #include "fieldrig/traits/plot_report.h"
 #include "fieldrig/traits/plot_traits.h"
@@ -83,26 +84,11 @@ int runTraits(const TraitsArgs& args) {
   return kExitOk;
 }
 
-// The trait definitions on the generator's noise-free visible plant geometry (after the same
-// depth crop and 1 cm voxel grid as the pipeline), as tests/traits/plot_truth.h does for tests.
+// The trait definitions on the generator's noise-free visible plant geometry (sim::plotTruth).
 Json truthJson(const sim::PlotCloud& plot, const traits::TraitsOptions& options) {
-  std::vector<Eigen::Vector3f> clean;
-  for (const sim::PlotSample& s : plot.truth.visible_plant_samples) {
-    if (s.position.z() >= options.crop_z_min_m && s.position.z() <= options.crop_z_max_m)
-      clean.push_back(s.position);
-  }
-  traits::TraitsOptions no_area = options;
-  no_area.area_method = traits::AreaMethod::kNone;
-  const traits::TraitsResult d = traits::traitsFromPlantPoints(
-      traits::voxelDownsample(clean, options.voxel_leaf_m, Eigen::Vector3f::Zero()),
-      plot.truth.ground_x_m, no_area);
-  double area = 0.0;
-  for (const sim::PlotSample& s : plot.truth.visible_plant_samples) {
-    const Eigen::Vector3f& p = s.position;
-    if (p.z() >= options.crop_z_min_m && p.z() <= options.crop_z_max_m && p.x() >= d.x_min &&
-        p.x() <= d.x_max && p.z() >= d.z_min && p.z() <= d.z_max)
-      area += s.area_m2;
-  }
+  const sim::PlotTruthTraits truth_traits = sim::plotTruth(plot, options);
+  const traits::TraitsResult& d = truth_traits.definitions;
+  const double area = truth_traits.visible_area_m2;
   Json truth;
   truth["status"] = traits::statusName(d.status);
   truth["height_m"] = d.height_m;
@@ -111,7 +97,7 @@ Json truthJson(const sim::PlotCloud& plot, const traits::TraitsOptions& options)
   truth["ega_m2"] = d.ega_m2;
   truth["total_volume_m3"] = d.total_volume_m3;
   truth["visible_area_in_box_m2"] = area;
-  truth["vai"] = d.ega_m2 > 0.0 ? area / d.ega_m2 : 0.0;
+  truth["vai"] = truth_traits.vai;
   truth["ground_x_m"] = plot.truth.ground_x_m;
   truth["base_depth_m"] = plot.truth.base_depth_m;
   truth["visible_plant_area_m2"] = plot.truth.visible_plant_area_m2;
