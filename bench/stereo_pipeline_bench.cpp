@@ -16,15 +16,12 @@
 
 #include "cloud/synthetic_rig.h"
 #include "fieldrig/cloud/fusion.h"
+#include "fieldrig/core/time.h"
 
 namespace {
 
 using namespace fieldrig;
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // CPU time of the whole process (all threads), ms: unlike wall time it barely moves when other
 // processes load the machine.
@@ -65,7 +62,7 @@ StageTimes runBuilder(cloud::CloudBuilder& builder, const std::vector<cloud::Hea
   const double cpu_start = processCpuMs();
   const cloud::FusionResult result = builder.build(frames, parallel);
   StageTimes t;
-  t.total = msSince(start);
+  t.total = fieldrig::core::millisecondsSince(start);
   t.cpu = processCpuMs() - cpu_start;
   for (const cloud::HeadStatus& head : result.heads) {
     t.debayer += head.timings.debayer_ms;
@@ -94,25 +91,25 @@ StageTimes runStraightforward(const cloud::RigConfig& rig,
     cv::cvtColor(frames[i].right, right_full, cv::COLOR_BayerRGGB2BGR);
     cv::resize(left_full, left, cv::Size(), rig.scale, rig.scale, cv::INTER_AREA);
     cv::resize(right_full, right, cv::Size(), rig.scale, rig.scale, cv::INTER_AREA);
-    t.debayer += msSince(start);
+    t.debayer += fieldrig::core::millisecondsSince(start);
     start = Clock::now();
     cv::Mat m1x, m1y, m2x, m2y, left_rect, right_rect;
     cv::initUndistortRectifyMap(c.M1, c.D1, c.R1, c.P1, left.size(), CV_32FC1, m1x, m1y);
     cv::initUndistortRectifyMap(c.M2, c.D2, c.R2, c.P2, left.size(), CV_32FC1, m2x, m2y);
     cv::remap(left, left_rect, m1x, m1y, cv::INTER_LINEAR);
     cv::remap(right, right_rect, m2x, m2y, cv::INTER_LINEAR);
-    t.rectify += msSince(start);
+    t.rectify += fieldrig::core::millisecondsSince(start);
     start = Clock::now();
     cv::Mat left_grey, right_grey, fixed, disparity;
     cv::cvtColor(left_rect, left_grey, cv::COLOR_BGR2GRAY);
     cv::cvtColor(right_rect, right_grey, cv::COLOR_BGR2GRAY);
     cv::StereoSGBM::create(0, rig.num_disparities, 3)->compute(left_grey, right_grey, fixed);
-    t.sgbm += msSince(start);
+    t.sgbm += fieldrig::core::millisecondsSince(start);
     start = Clock::now();
     fixed.convertTo(disparity, CV_32F, 1.0 / 16);
     cv::Mat xyz;
     cv::reprojectImageTo3D(disparity, xyz, c.Q, true);
-    t.reproject += msSince(start);
+    t.reproject += fieldrig::core::millisecondsSince(start);
     start = Clock::now();
     cv::Matx44d plot = cv::Matx44d::eye();
     for (int r = 0; r < 3; ++r) {
@@ -137,9 +134,9 @@ StageTimes runStraightforward(const cloud::RigConfig& rig,
         fused.push_back(point);
       }
     }
-    t.fuse += msSince(start);
+    t.fuse += fieldrig::core::millisecondsSince(start);
   }
-  t.total = msSince(all);
+  t.total = fieldrig::core::millisecondsSince(all);
   t.cpu = processCpuMs() - cpu_start;
   t.points = fused.size();
   return t;

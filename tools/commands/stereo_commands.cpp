@@ -22,6 +22,7 @@
 #include "commands/session_frames.h"
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/cloud/rig.h"
+#include "fieldrig/core/time.h"
 #include "fieldrig/recording/session_reader.h"
 #include "fieldrig/stereo/calibrate.h"
 #include "fieldrig/stereo/calibration.h"
@@ -35,10 +36,6 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // Files matching a shell pattern, sorted (the shell may also have expanded it already: a plain
 // existing file matches itself).
@@ -295,7 +292,7 @@ int runDisparity(const DisparityArgs& args) {
   stereo::DisparityMatcher matcher(options);
   const auto start = Clock::now();
   const cv::Mat disparity = matcher.compute(left, right);
-  const double ms = msSince(start);
+  const double ms = core::millisecondsSince(start);
   auto written = stereo::writePfm(args.out, disparity);
   if (!written) {
     std::cerr << who << written.error().message << '\n';
@@ -427,7 +424,7 @@ int runCloud(const CloudArgs& args) {
   out["partial"] = result.partial();
   out["heads"] = std::move(heads);
   out["problems"] = problems;
-  out["ms"] = msSince(start);
+  out["ms"] = core::millisecondsSince(start);
   std::cout << out.dump() << '\n';
   return kExitOk;
 }

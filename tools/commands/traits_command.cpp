@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands/commands.h"
+#include "fieldrig/cloud/fusion.h"
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/traits/cloud_io.h"
@@ -119,21 +120,26 @@ int runSynth(const SynthArgs& args) {
   sim::PlotCloud plot = sim::generatePlot(spec);
   if (args.points > 0)
     sim::subsamplePlot(plot, args.points, args.seed);
-  std::vector<Eigen::Vector3f> points = plot.points;
-  if (args.frame == "camera") {
-    const Eigen::Matrix3f plot_to_camera =
-        traits::TraitsOptions{}.camera_to_plot.transpose().cast<float>();
-    for (Eigen::Vector3f& p : points)
-      p = plot_to_camera * p;
+  Eigen::Matrix3f to_output = Eigen::Matrix3f::Identity();
+  if (args.frame == "camera")
+    to_output = traits::TraitsOptions{}.camera_to_plot.transpose().cast<float>();
+  cloud::Cloud out;
+  out.reserve(plot.points.size());
+  for (std::size_t i = 0; i < plot.points.size(); ++i) {
+    pcl::PointXYZRGB p;
+    p.getVector3fMap() = to_output * plot.points[i];
+    p.r = plot.colors[i][0];
+    p.g = plot.colors[i][1];
+    p.b = plot.colors[i][2];
+    out.push_back(p);
   }
-  core::Result<bool> saved = traits::saveCloudPly(args.out, points, plot.colors);
-  if (!saved) {
+  if (auto saved = cloud::writePly(out, args.out); !saved) {
     std::cerr << "fieldrig traits synth: " << saved.error().message << '\n';
     return kExitBadInput;
   }
   if (!args.truth.empty()) {
     Json truth = truthJson(plot, traits::TraitsOptions{});
-    truth["points"] = points.size();
+    truth["points"] = out.size();
     truth["frame"] = args.frame;
     core::Result<bool> written = traits::writeText(args.truth, truth.dump(1) + "\n");
     if (!written) {

@@ -1,4 +1,5 @@
 #include "fieldrig/cloud/fusion.h"
+#include "fieldrig/core/time.h"
 
 #include <pcl/io/ply_io.h>
 
@@ -11,10 +12,6 @@ namespace fieldrig::cloud {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 }  // namespace
 
@@ -74,7 +71,7 @@ std::size_t appendReprojected(const cv::Mat& disparity, const cv::Mat& left_bgr,
     }
   }
   if (reproject_ms)
-    *reproject_ms = msSince(start);
+    *reproject_ms = core::millisecondsSince(start);
   return out.size() - before;
 }
 
@@ -174,7 +171,7 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
   result.cloud.width = static_cast<std::uint32_t>(result.cloud.size());
   result.cloud.height = 1;
   result.cloud.is_dense = true;
-  result.fuse_ms = msSince(start);
+  result.fuse_ms = core::millisecondsSince(start);
   return result;
 }
 

@@ -1,4 +1,5 @@
 #include "fieldrig/stereo/head.h"
+#include "fieldrig/core/time.h"
 
 #include <chrono>
 
@@ -8,10 +9,6 @@ namespace fieldrig::stereo {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 std::string sizeText(cv::Size size) {
   return std::to_string(size.width) + "x" + std::to_string(size.height);
@@ -63,13 +60,13 @@ core::Result<HeadOutput> HeadPipeline::process(const cv::Mat& raw_left, const cv
   if (!right)
     return core::Error{name + ": right image: " + right.error().message};
   if (timings)
-    timings->debayer_ms = msSince(start);
+    timings->debayer_ms = core::millisecondsSince(start);
   start = Clock::now();
   HeadOutput out;
   cv::Mat right_rectified;
   rectifier_.rectify(*left, *right, out.left_bgr, right_rectified);
   if (timings)
-    timings->rectify_ms = msSince(start);
+    timings->rectify_ms = core::millisecondsSince(start);
   out.disparity =
       matcher_.compute(out.left_bgr, right_rectified, timings ? &timings->match : nullptr);
   return out;

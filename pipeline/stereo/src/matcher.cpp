@@ -1,4 +1,5 @@
 #include "fieldrig/stereo/matcher.h"
+#include "fieldrig/core/time.h"
 
 #include <chrono>
 #include <cmath>
@@ -8,10 +9,6 @@ namespace fieldrig::stereo {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 cv::Mat toChannels(const cv::Mat& image, bool colour) {
   if (colour) {
@@ -111,7 +108,7 @@ cv::Mat DisparityMatcher::compute(const cv::Mat& left, const cv::Mat& right,
     right_matcher_->compute(right_in, left_in, right_fixed);
   }
   if (timings)
-    timings->sgbm_ms = msSince(start);
+    timings->sgbm_ms = core::millisecondsSince(start);
   start = Clock::now();
   cv::Mat disparity;
   if (wls_) {
@@ -125,7 +122,7 @@ cv::Mat DisparityMatcher::compute(const cv::Mat& left, const cv::Mat& right,
     }
   }
   if (timings)
-    timings->filter_ms = msSince(start);
+    timings->filter_ms = core::millisecondsSince(start);
   return disparity;
 }
 

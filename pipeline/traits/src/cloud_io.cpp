@@ -44,32 +44,4 @@ core::Result<std::vector<Eigen::Vector3f>> loadCloud(const std::string& path) {
   return points;
 }
 
-core::Result<bool> saveCloudPly(const std::string& path, const std::vector<Eigen::Vector3f>& points,
-                                const std::vector<std::array<std::uint8_t, 3>>& colors) {
-  pcl::PointCloud<pcl::PointXYZRGB> cloud;
-  cloud.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    pcl::PointXYZRGB p;
-    p.x = points[i].x();
-    p.y = points[i].y();
-    p.z = points[i].z();
-    if (i < colors.size()) {
-      p.r = colors[i][0];
-      p.g = colors[i][1];
-      p.b = colors[i][2];
-    }
-    cloud.push_back(p);
-  }
-  if (cloud.empty()) {
-    // PCL refuses to write an empty cloud; an empty plot is still a valid (if useless) file.
-    cloud.width = 0;
-    cloud.height = 1;
-  }
-  // Without PCL's "camera" element, whose properties PCL's own reader then warns about.
-  pcl::PLYWriter writer;
-  if (writer.write(path, cloud, /*binary=*/true, /*use_camera=*/false) < 0)
-    return core::Error{path + ": cannot write the PLY file"};
-  return true;
-}
-
 }  // namespace fieldrig::traits

@@ -1,4 +1,5 @@
 #include "fieldrig/traits/plot_traits.h"
+#include "fieldrig/core/time.h"
 
 #include <Eigen/Geometry>
 
@@ -15,10 +16,6 @@ namespace {
 
 using Points = std::vector<Eigen::Vector3f>;
 using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 TraitsResult failed(TraitsResult result, TraitsStatus status, std::string message) {
   result.status = status;
@@ -209,7 +206,7 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& plant_poi
   result.z_max = weightedMedian(z_max);
   result.height_m = result.x_max - result.x_min;
   result.width_m = result.z_max - result.z_min;
-  result.timings.slices_ms = msSince(slices_start);
+  result.timings.slices_ms = core::millisecondsSince(slices_start);
   if (!(result.height_m > 0.0) || !(result.width_m > 0.0))
     return failed(std::move(result), TraitsStatus::kNoPlants,
                   "no plant above the ground: height " + std::to_string(result.height_m) +
@@ -246,7 +243,7 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& plant_poi
       result.total_volume_m3 += s.hull_volume_m3;
     }
   }
-  result.timings.hulls_ms = msSince(hulls_start);
+  result.timings.hulls_ms = core::millisecondsSince(hulls_start);
   const double beta = static_cast<double>(result.quality.valid_slices) / n;
   result.ega_m2 = beta * row_extent * result.width_m;
 
@@ -279,7 +276,7 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& plant_poi
     case AreaMethod::kNone:
       break;
   }
-  result.timings.area_ms = msSince(area_start);
+  result.timings.area_ms = core::millisecondsSince(area_start);
   if (result.quality.valid_slices == 0) {
     // Height and width stand; without a valid slice there is no EGA, so no VVI and no VAI.
     result.status = TraitsStatus::kNoValidSlices;
@@ -353,7 +350,7 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
     cloud = removeSparseOutliers(cloud, options.voxel_leaf_m, options.outlier_min_neighbours,
                                  q.points_outliers);
   }
-  result.timings.filter_ms = msSince(filter_start);
+  result.timings.filter_ms = core::millisecondsSince(filter_start);
   if (cloud.size() < options.min_plant_points)
     return failed(std::move(result), TraitsStatus::kNoPlants,
                   std::to_string(cloud.size()) + " points left after the depth crop and filters");
@@ -423,7 +420,7 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
       plants.push_back(p);
     }
   }
-  result.timings.ground_ms = msSince(ground_start);
+  result.timings.ground_ms = core::millisecondsSince(ground_start);
 
   TraitsResult traits = traitsFromPlantPoints(plants, edge_centre.x(), options);
   traits.quality.points_in = q.points_in;
@@ -444,7 +441,7 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
   traits.timings.ground_ms = result.timings.ground_ms;
   if (!std::isfinite(traits.quality.alpha_margin))
     traits.quality.alpha_margin = 0.0;
-  traits.timings.total_ms = msSince(start);
+  traits.timings.total_ms = core::millisecondsSince(start);
   return traits;
 }
 

@@ -30,6 +30,13 @@ struct ReceptionStamp {
   }
 };
 
+// Milliseconds on the steady clock since `start`, as a double: the stage timings of the pipeline
+// and its benchmarks.
+inline double millisecondsSince(SteadyTime start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
 // Seconds as a double, for arithmetic on short intervals (sub-nanosecond error up to days).
 inline double toSeconds(Nanoseconds d) {
   return std::chrono::duration<double>(d).count();
