@@ -108,7 +108,7 @@ sim::TriggerAccuracy pool(const std::vector<sim::TriggerAccuracy>& runs) {
 int run(int argc, char** argv) {
   int seeds = 10;
   double noise = 0.01;
-  double latency = gps::ReplayOptions{}.latency_s;
+  double latency = gps::TriggerChainOptions{}.latency_s;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--seeds"))
       seeds = std::atoi(argv[i + 1]);
@@ -141,7 +141,7 @@ int run(int argc, char** argv) {
       const sim::DriveSimulator drive(fieldPlan(), options);
       const std::string nmea = drive.nmea();
       std::vector<core::TriggerEvent> events;
-      gps::ReplayOptions replay;
+      gps::TriggerChainOptions replay;
       replay.latency_s = latency;
       std::istringstream in(nmea);
       auto t0 = std::chrono::steady_clock::now();

@@ -12,12 +12,6 @@ constexpr auto kIdlePoll = std::chrono::microseconds{500};
 // room for this many sets (about 1 KB each, allocated at start) before one could be lost.
 constexpr std::size_t kRecorderQueueSets = 4096;
 
-const std::vector<std::string>& defaultCameraNames() {
-  static const std::vector<std::string> names = {"bottom_left",  "bottom_right", "middle_left",
-                                                 "middle_right", "top_left",     "top_right"};
-  return names;
-}
-
 std::string_view statusReason(core::FrameStatus status) {
   switch (status) {
     case core::FrameStatus::kOk:
@@ -36,22 +30,16 @@ std::string_view statusReason(core::FrameStatus status) {
 
 core::Result<std::unique_ptr<Acquisition>> Acquisition::create(
     AcquisitionOptions options, const drivers::CameraRegistry& registry) {
-  if (options.camera_names.empty()) {
-    for (std::size_t i = 0; i < options.rig.cameras.size(); ++i) {
-      options.camera_names.push_back(
-          i < defaultCameraNames().size() ? defaultCameraNames()[i] : "camera" + std::to_string(i));
-    }
-  }
-  if (options.camera_names.size() != options.rig.cameras.size()) {
-    return core::Error{"acquisition: " + std::to_string(options.camera_names.size()) +
-                       " camera names for " + std::to_string(options.rig.cameras.size()) +
-                       " cameras"};
-  }
   auto rig = drivers::Rig::create(options.rig, registry);
   if (!rig)
     return rig.error();
   std::unique_ptr<Acquisition> acquisition(new Acquisition(std::move(options)));
   acquisition->rig_ = std::move(*rig);
+  const core::RigLayout& layout = acquisition->options_.layout;
+  for (std::size_t i = 0; i < acquisition->options_.rig.cameras.size(); ++i) {
+    acquisition->camera_names_.push_back(i < layout.cameraCount() ? layout.cameraName(i)
+                                                                  : "camera" + std::to_string(i));
+  }
   auto opened =
       acquisition->writer_.open(acquisition->options_.session_dir, acquisition->options_.session,
                                 acquisition->options_.writer);
@@ -96,10 +84,27 @@ core::Result<bool> Acquisition::start(ProcessSet process) {
   return true;
 }
 
-bool Acquisition::trigger() {
-  const bool accepted = rig_->trigger(next_trigger_id_++);
-  ++triggered_;
+bool Acquisition::trigger(core::TriggerEvent event) {
+  event.trigger_id = next_trigger_id_++;
+  const bool accepted = rig_->trigger(event);
+  triggered_.fetch_add(1);
   return accepted;
+}
+
+bool Acquisition::trigger() {
+  return trigger(core::TriggerEvent{});
+}
+
+std::uint64_t Acquisition::inFlight() const {
+  const std::uint64_t triggered = triggered_.load();
+  const std::uint64_t refused = rig_->stats().triggers_refused;
+  const std::uint64_t left_recording = recorded_.load() + lost_.load() + refused;
+  std::uint64_t in_flight = triggered > left_recording ? triggered - left_recording : 0;
+  if (process_) {
+    const std::uint64_t left_processing = processed_.load() + skipped_.load() + refused;
+    in_flight = std::max(in_flight, triggered > left_processing ? triggered - left_processing : 0);
+  }
+  return in_flight;
 }
 
 void Acquisition::finish(std::chrono::milliseconds timeout) {
@@ -132,14 +137,33 @@ void Acquisition::recordLoop() {
     record.trigger_id = set.trigger_id;
     record.complete = set.complete();
     record.skew_us = static_cast<double>(set.skew_ns) / 1000.0;
-    record.trigger_time = core::UtcTime{std::chrono::duration_cast<core::Nanoseconds>(
-        std::chrono::system_clock::now().time_since_epoch())};
+    const core::TriggerEvent& event = set.trigger;
+    if (event.location_id.empty()) {  // a manual trigger: when the rig sent it, host clock
+      record.location_id.reset();
+      record.fix.reset();
+      record.trigger_time = event.sent_time != core::UtcTime{}
+                                ? event.sent_time
+                                : core::UtcTime{std::chrono::duration_cast<core::Nanoseconds>(
+                                      std::chrono::system_clock::now().time_since_epoch())};
+      record.planned_time.reset();
+      record.trigger_status.reset();
+    } else {
+      record.location_id = event.location_id;
+      record.fix = event.fix;
+      record.trigger_time = event.time;
+      record.planned_time = event.planned_time;
+      record.trigger_status = std::string(core::toString(event.status));
+    }
+    if (event.sent_time != core::UtcTime{})
+      record.sent_time = event.sent_time;
+    else
+      record.sent_time.reset();
     record.frames.resize(set.camera_count);
     for (std::uint32_t c = 0; c < set.camera_count; ++c) {
       const core::Frame& frame = set.frames[c];
       recording::FrameView& view = record.frames[c];
       view.camera_index = static_cast<int>(c);
-      view.camera_name = options_.camera_names[c];
+      view.camera_name = camera_names_[c];
       view.width = static_cast<int>(frame.metadata.width);
       view.height = static_cast<int>(frame.metadata.height);
       view.stride = static_cast<int>(frame.metadata.stride);

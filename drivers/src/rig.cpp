@@ -79,8 +79,18 @@ void Rig::stop() {
 }
 
 bool Rig::trigger(std::uint64_t trigger_id) {
+  core::TriggerEvent event;
+  event.trigger_id = trigger_id;
+  return trigger(event);
+}
+
+bool Rig::trigger(const core::TriggerEvent& trigger_event) {
+  const std::uint64_t trigger_id = trigger_event.trigger_id;
   const core::SteadyTime issued = std::chrono::steady_clock::now();
-  if (!running_ || !trigger_queue_.tryPush({trigger_id, issued})) {
+  IssuedTrigger issued_trigger{trigger_event, issued};
+  issued_trigger.event.sent_time = core::UtcTime{std::chrono::duration_cast<core::Nanoseconds>(
+      std::chrono::system_clock::now().time_since_epoch())};
+  if (!running_ || !trigger_queue_.tryPush(issued_trigger)) {
     triggers_refused_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
@@ -106,7 +116,7 @@ void Rig::run() {
 
 bool Rig::drain() {
   bool any = false;
-  std::pair<std::uint64_t, core::SteadyTime> trigger;
+  IssuedTrigger trigger;
   while (trigger_queue_.tryPop(trigger)) {
     any = true;
     if (pending_count_ == pending_.size()) {
@@ -119,14 +129,15 @@ bool Rig::drain() {
     ++pending_count_;
     pending.set = core::FrameSet{};  // releases nothing: emitted slots are already empty
     pending.arrived = 0;
-    pending.set.trigger_id = trigger.first;
+    pending.set.trigger_id = trigger.event.trigger_id;
+    pending.set.trigger = std::move(trigger.event);
     pending.set.camera_count = static_cast<std::uint32_t>(cameras_.size());
     for (std::uint32_t c = 0; c < cameras_.size(); ++c) {
       pending.set.frames[c].metadata.camera = c;
-      pending.set.frames[c].metadata.trigger_id = trigger.first;
+      pending.set.frames[c].metadata.trigger_id = pending.set.trigger_id;
       pending.set.frames[c].metadata.status = core::FrameStatus::kMissing;
     }
-    pending.deadline = trigger.second + options_.frame_timeout;
+    pending.deadline = trigger.issued + options_.frame_timeout;
   }
   core::Frame frame;
   for (auto& queue : frame_queues_) {

@@ -10,7 +10,7 @@ constexpr std::size_t kOffsetWindow = 50;
 }  // namespace
 
 LiveTriggerChain::LiveTriggerChain(boost::asio::io_context& io, const LocationMap& map,
-                                   LiveTriggerOptions options, TriggerHandler on_trigger,
+                                   TriggerChainOptions options, TriggerHandler on_trigger,
                                    AlarmHandler on_alarm, FixHandler on_fix)
     : timer_(io),
       options_(options),

@@ -130,6 +130,7 @@ struct TriggerPlanner::State {
 
   std::optional<core::UtcTime> origin;  // time zero of Sample::t
   std::optional<core::UtcTime> last_fix_time;
+  std::optional<core::GpsFix> last_valid_fix;  // carried by the events planned on it
   std::deque<Sample> samples;
   std::optional<Track> track;
   std::optional<EnuPoint> last_planned_position;  // the track's position at the last plan
@@ -320,6 +321,7 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
     s.restartTrack();
     return;
   }
+  s.last_valid_fix = fix;
   const double t = s.seconds(fix.time);
   if (!s.samples.empty() && t - s.samples.back().t > s.options.max_fix_gap_s)
     s.restartTrack();
@@ -405,6 +407,8 @@ std::vector<core::TriggerEvent> TriggerPlanner::collectDue(core::UtcTime now) {
     event.course_deg = p.course_deg;
     event.cross_track_m = p.cross_track;
     event.last_fix_time = p.last_fix_time;
+    if (s.last_valid_fix && s.last_valid_fix->time == p.last_fix_time)
+      event.fix = s.last_valid_fix;
     ++s.stats.triggers;
     if (p.status == core::TriggerStatus::kLate)
       ++s.stats.triggers_late;

@@ -9,7 +9,7 @@
 namespace fieldrig::gps {
 
 ReplaySummary replayTriggers(std::istream& nmea, const LocationMap& map,
-                             const ReplayOptions& options, const ReplayHandlers& handlers) {
+                             const TriggerChainOptions& options, const ReplayHandlers& handlers) {
   TriggerPlanner planner(map, options.planner);
   FixAssembler assembler;
   const core::Nanoseconds latency = core::fromSeconds(options.latency_s);

@@ -11,23 +11,18 @@
 #include <string_view>
 #include <vector>
 
+#include "fieldrig/core/durable_file.h"
 #include "fieldrig/core/result.h"
 #include "fieldrig/recording/session_format.h"
 
 namespace fieldrig::recording::detail {
 
-// Writes all `size` bytes, retrying short and interrupted writes; 0 or the errno.
-int writeFully(int fd, const void* data, std::size_t size);
-
-// fsync of a folder, so that the names created or renamed in it survive a power loss; 0 or errno.
-int syncDirectory(const std::filesystem::path& dir);
-
-// Reads a whole file; nullopt with `error` set ("PATH: reason") when it cannot.
-std::optional<std::string> readWholeFile(const std::filesystem::path& path, std::string& error);
-
-// Writes `text` to `path` through a temporary file, fsync and rename, so that a reader sees the
-// old or the new content, never a mix. Empty on success, else "PATH: reason".
-std::string replaceFileAtomically(const std::filesystem::path& path, std::string_view text);
+// Whole writes, folder syncs and atomic replacement are core's (one way to write a file that
+// must survive a crash).
+using core::readWholeFile;
+using core::replaceFileAtomically;
+using core::syncDirectory;
+using core::writeFully;
 
 // "P5\n<width> <height>\n255\n".
 std::string pgmHeader(int width, int height);

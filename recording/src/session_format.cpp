@@ -185,6 +185,13 @@ std::string toIndexLine(const IndexedSet& set) {
   out["trigger_id"] = set.trigger_id;
   out["location_id"] = optionalJson(set.location_id);
   out["trigger_time"] = core::formatIso8601(set.trigger_time, 9);
+  // Written only for sets a location asked for, so that older readers see the lines they know.
+  if (set.planned_time)
+    out["planned_time"] = core::formatIso8601(*set.planned_time, 9);
+  if (set.sent_time)
+    out["sent_time"] = core::formatIso8601(*set.sent_time, 9);
+  if (set.trigger_status)
+    out["trigger_status"] = *set.trigger_status;
   out["complete"] = set.complete;
   out["skew_us"] = set.skew_us;
   out["gps"] = set.fix ? fixJson(*set.fix) : Json(nullptr);
@@ -208,6 +215,11 @@ std::optional<IndexedSet> fromIndexLine(std::string_view line, std::string& erro
     set.trigger_id = in.at("trigger_id").get<std::uint64_t>();
     set.location_id = optionalFrom<std::string>(in, "location_id");
     set.trigger_time = timeFrom(in.at("trigger_time"), "trigger_time");
+    if (in.contains("planned_time"))
+      set.planned_time = timeFrom(in.at("planned_time"), "planned_time");
+    if (in.contains("sent_time"))
+      set.sent_time = timeFrom(in.at("sent_time"), "sent_time");
+    set.trigger_status = optionalFrom<std::string>(in, "trigger_status");
     set.complete = in.at("complete").get<bool>();
     set.skew_us = in.at("skew_us").get<double>();
     if (!in.at("gps").is_null())

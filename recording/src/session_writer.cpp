@@ -289,6 +289,9 @@ WriteOutcome SessionWriter::write(const FrameSetRecord& record) {
   entry_.location_id = record.location_id;
   entry_.fix = record.fix;
   entry_.trigger_time = record.trigger_time;
+  entry_.planned_time = record.planned_time;
+  entry_.sent_time = record.sent_time;
+  entry_.trigger_status = record.trigger_status;
   entry_.complete = record.complete;
   entry_.skew_us = record.skew_us;
   entry_.frames.resize(record.frames.size());

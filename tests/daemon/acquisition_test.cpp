@@ -74,6 +74,59 @@ TEST(AcquisitionTest, EveryTriggeredSetIsRecordedAndReadsBackIdentically) {
   EXPECT_TRUE(reader->verify().ok());
 }
 
+TEST(AcquisitionTest, ARecordedSetNamesItsTriggersLocationFixAndTimes) {
+  const ScopedTempDir dir("acquisition_event");
+  auto acquisition = Acquisition::create(smallRig(dir.path()), drivers::CameraRegistry::instance());
+  ASSERT_TRUE(acquisition.ok()) << acquisition.error().message;
+  ASSERT_TRUE((*acquisition)->start().ok());
+  const core::UtcTime base = core::UtcTime{} + std::chrono::hours{24 * 20600};
+  for (int i = 0; i < 3; ++i) {
+    core::TriggerEvent event;
+    event.trigger_id = 99;  // the planner's own numbering: replaced by the session's
+    event.location_id = "R01P0" + std::to_string(i + 1);
+    event.time = base + std::chrono::seconds{2 * i} + 5ms;
+    event.planned_time = base + std::chrono::seconds{2 * i};
+    event.status = i == 2 ? core::TriggerStatus::kLate : core::TriggerStatus::kOnTime;
+    core::GpsFix fix;
+    fix.time = base + std::chrono::seconds{2 * i} - 40ms;
+    fix.valid = true;
+    fix.has_date = true;
+    fix.latitude_deg = 42.0 + 0.0001 * i;
+    fix.longitude_deg = -93.6;
+    fix.speed_mps = 2.0;
+    event.fix = fix;
+    (*acquisition)->trigger(event);
+  }
+  (*acquisition)->trigger();  // a manual trigger: no location, no fix
+  (*acquisition)->finish(10s);
+  const auto reader = recording::SessionReader::open(dir.path() / "session");
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  ASSERT_EQ(reader->sets().size(), 4u);
+  for (int i = 0; i < 3; ++i) {
+    const recording::IndexedSet& set = reader->sets()[static_cast<std::size_t>(i)];
+    SCOPED_TRACE(i);
+    EXPECT_EQ(set.trigger_id, static_cast<std::uint64_t>(i + 1));
+    ASSERT_TRUE(set.location_id.has_value());
+    EXPECT_EQ(*set.location_id, "R01P0" + std::to_string(i + 1));
+    EXPECT_EQ(set.trigger_time, base + std::chrono::seconds{2 * i} + 5ms);
+    ASSERT_TRUE(set.planned_time.has_value());
+    EXPECT_EQ(*set.planned_time, base + std::chrono::seconds{2 * i});
+    ASSERT_TRUE(set.sent_time.has_value());
+    EXPECT_GT(set.sent_time->time_since_epoch().count(), 0);
+    EXPECT_EQ(set.trigger_status.value_or(""), i == 2 ? "late" : "on_time");
+    ASSERT_TRUE(set.fix.has_value());
+    EXPECT_EQ(set.fix->time, base + std::chrono::seconds{2 * i} - 40ms);
+    EXPECT_DOUBLE_EQ(set.fix->latitude_deg, 42.0 + 0.0001 * i);
+    ASSERT_TRUE(set.fix->speed_mps.has_value());
+    EXPECT_DOUBLE_EQ(*set.fix->speed_mps, 2.0);
+  }
+  const recording::IndexedSet& manual = reader->sets()[3];
+  EXPECT_FALSE(manual.location_id.has_value());
+  EXPECT_FALSE(manual.fix.has_value());
+  EXPECT_FALSE(manual.planned_time.has_value());
+  EXPECT_TRUE(manual.sent_time.has_value());
+}
+
 TEST(AcquisitionTest, IncompleteSetsAreRecordedWithTheMissingCameraMarked) {
   const ScopedTempDir dir("acquisition_incomplete");
   AcquisitionOptions options = smallRig(dir.path());

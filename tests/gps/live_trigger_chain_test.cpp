@@ -55,7 +55,7 @@ TEST(LiveTriggerChainTest, FiresOnTheSteadyClockAtThePlannedGpsTime) {
 
   boost::asio::io_context io;
   const auto latency = 50ms;
-  LiveTriggerOptions options;
+  TriggerChainOptions options;
   options.latency_s = 0.05;
   struct Fired {
     core::TriggerEvent event;

@@ -17,6 +17,7 @@
 
 #include "recording/test_helpers.h"
 #include "support/temp_dir.h"
+#include "support/tmpfs_mount.h"
 
 namespace fieldrig::recording {
 namespace {
@@ -25,33 +26,7 @@ namespace fs = std::filesystem;
 using testing_support::ScopedTempDir;
 using testing_support::SyntheticRig;
 
-// A tmpfs of `size` mounted on `dir` for the guard's lifetime.
-class TmpfsMount {
- public:
-  TmpfsMount(const fs::path& dir, const std::string& size) : dir_(dir) {
-    fs::create_directories(dir);
-    const std::string options = "size=" + size;
-    if (::mount("tmpfs", dir.c_str(), "tmpfs", 0, options.c_str()) == 0) {
-      mounted_ = true;
-    } else {
-      error_ = std::strerror(errno);
-    }
-  }
-  ~TmpfsMount() {
-    if (mounted_)
-      ::umount2(dir_.c_str(), MNT_DETACH);
-  }
-  TmpfsMount(const TmpfsMount&) = delete;
-  TmpfsMount& operator=(const TmpfsMount&) = delete;
-
-  bool mounted() const { return mounted_; }
-  const std::string& error() const { return error_; }
-
- private:
-  fs::path dir_;
-  bool mounted_ = false;
-  std::string error_;
-};
+using testing_support::TmpfsMount;
 
 // What must hold after the writer stopped at a full disk with `ok_sets` sets written.
 void expectWholeSessionOf(const fs::path& session, std::uint64_t ok_sets) {

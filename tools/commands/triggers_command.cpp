@@ -23,7 +23,7 @@ struct TriggersArgs {
   std::string map_path;
   std::string nmea_path;
   unsigned baud = 115200;
-  gps::ReplayOptions replay;
+  gps::TriggerChainOptions replay;
 };
 
 std::string_view alarmName(gps::AlarmKind kind) {
@@ -74,7 +74,7 @@ Json summaryJson(const gps::LocationMap& map, const gps::NmeaStats& nmea,
 // Live: the receiver on a serial device; triggers fire on a steady_timer until SIGINT/SIGTERM.
 int runLive(const TriggersArgs& args, const gps::LocationMap& map) {
   boost::asio::io_context io;
-  gps::LiveTriggerOptions options;
+  gps::TriggerChainOptions options;
   options.planner = args.replay.planner;
   options.latency_s = args.replay.latency_s;
   gps::LiveTriggerChain chain(

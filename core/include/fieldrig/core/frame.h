@@ -9,6 +9,7 @@
 #include "fieldrig/core/frame_pool.h"
 #include "fieldrig/core/pixel_format.h"
 #include "fieldrig/core/time.h"
+#include "fieldrig/core/trigger_event.h"
 
 namespace fieldrig::core {
 
@@ -42,6 +43,10 @@ struct FrameSet {
   static constexpr std::size_t kMaxCameras = 8;
 
   std::uint64_t trigger_id = 0;
+  // What the trigger was for: location, fix, planned and sent times (trigger.trigger_id equals
+  // trigger_id). Its strings fit the small-string buffer for map ids of up to 15 characters, so
+  // moving a set through the queues still allocates nothing in the field.
+  TriggerEvent trigger;
   std::uint32_t camera_count = 0;
   std::array<Frame, kMaxCameras> frames{};
   std::int64_t skew_ns = 0;  // spread of the device timestamps of the frames present

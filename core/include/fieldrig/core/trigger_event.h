@@ -2,9 +2,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
+#include "fieldrig/core/gps_fix.h"
 #include "fieldrig/core/time.h"
 
 namespace fieldrig::core {
@@ -24,10 +26,14 @@ struct TriggerEvent {
   UtcTime time{};                // GPS time at which the trigger fires
   UtcTime planned_time{};        // the predicted crossing (equals `time` unless late)
   TriggerStatus status = TriggerStatus::kOnTime;
-  double speed_mps = 0;      // estimated ground speed when planned
-  double course_deg = 0;     // estimated course over ground when planned
-  double cross_track_m = 0;  // signed lateral offset of the location (+ = right of travel)
-  UtcTime last_fix_time{};   // the latest fix the plan used (always before `time`)
+  double speed_mps = 0;       // estimated ground speed when planned
+  double course_deg = 0;      // estimated course over ground when planned
+  double cross_track_m = 0;   // signed lateral offset of the location (+ = right of travel)
+  UtcTime last_fix_time{};    // the latest fix the plan used (always before `time`)
+  std::optional<GpsFix> fix;  // that fix itself: where the tractor was, as the receiver said
+  // Host clock when the rig sent the trigger to the cameras (set by the rig; zero for triggers
+  // that never reached one).
+  UtcTime sent_time{};
 };
 
 }  // namespace fieldrig::core

@@ -21,7 +21,9 @@
 #include <vector>
 
 #include "fieldrig/core/frame.h"
+#include "fieldrig/core/rig_layout.h"
 #include "fieldrig/core/spsc_queue.h"
+#include "fieldrig/core/trigger_event.h"
 #include "fieldrig/drivers/rig.h"
 #include "fieldrig/recording/session_writer.h"
 
@@ -32,7 +34,7 @@ struct AcquisitionOptions {
   std::filesystem::path session_dir;
   recording::SessionInfo session;
   recording::WriterOptions writer;
-  std::vector<std::string> camera_names;  // one per camera; default bottom_left … top_right
+  core::RigLayout layout;  // names the cameras (rig order); cameras beyond it are "cameraN"
   std::size_t processing_queue_sets = 2;
 };
 
@@ -58,13 +60,21 @@ class Acquisition {
 
   // Starts the recorder (and processing, when given) and the rig.
   core::Result<bool> start(ProcessSet process = {});
-  // Triggers the next set; its trigger id continues the session's numbering. Never blocks.
+  // Triggers the next set for a location the planner chose: the event (location, fix, times)
+  // travels with the set into the recording and to processing. Its trigger id is replaced by the
+  // session's own numbering, which continues across reopenings. Never blocks.
+  bool trigger(core::TriggerEvent event);
+  // A set no location asked for (manual, `fieldrig acquire`): stamped with the host clock.
   bool trigger();
   // Waits (bounded) until every triggered set has left the rig and been recorded, then stops.
   void finish(std::chrono::milliseconds timeout);
 
   AcquisitionStats stats() const;
-  std::uint64_t triggered() const { return triggered_; }
+  std::uint64_t triggered() const { return triggered_.load(); }
+  // Triggered sets that have not yet left the pipeline: not recorded (or lost) or, when live
+  // processing runs, not processed or skipped. Virtual-time replay paces itself on this.
+  std::uint64_t inFlight() const;
+  const std::vector<std::string>& cameraNames() const { return camera_names_; }
   std::size_t poolBytes() const;
 
  private:
@@ -78,8 +88,9 @@ class Acquisition {
   std::unique_ptr<core::SpscQueue<core::FrameSet>> to_recorder_;
   std::unique_ptr<core::SpscQueue<core::FrameSet>> to_processing_;
   ProcessSet process_;
+  std::vector<std::string> camera_names_;
   std::uint64_t next_trigger_id_ = 1;
-  std::uint64_t triggered_ = 0;
+  std::atomic<std::uint64_t> triggered_{0};
   std::atomic<bool> running_{false};
   std::thread recorder_;
   std::thread processor_;

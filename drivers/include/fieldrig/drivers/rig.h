@@ -62,7 +62,10 @@ class Rig {
   core::Result<bool> start(SetSink sink);
   // Stops the cameras, emits what is pending (incomplete), joins the rig thread.
   void stop();
-  // Triggers every camera for `trigger_id` (increasing). Never blocks; false if refused.
+  // Triggers every camera for `event.trigger_id` (increasing); the event travels with the set
+  // (its sent_time is stamped here). Never blocks; false if refused.
+  bool trigger(const core::TriggerEvent& event);
+  // A trigger that no location asked for (manual, tests, `fieldrig acquire`).
   bool trigger(std::uint64_t trigger_id);
 
   RigStats stats() const;  // a snapshot; thread-safe
@@ -89,7 +92,11 @@ class Rig {
   std::vector<std::unique_ptr<Camera>> cameras_;
   std::unique_ptr<core::FramePool> pool_;
   std::vector<std::unique_ptr<core::SpscQueue<core::Frame>>> frame_queues_;  // one per camera
-  core::SpscQueue<std::pair<std::uint64_t, core::SteadyTime>> trigger_queue_{1024};
+  struct IssuedTrigger {
+    core::TriggerEvent event;
+    core::SteadyTime issued{};
+  };
+  core::SpscQueue<IssuedTrigger> trigger_queue_{1024};
   SetSink sink_;
   // Sets waiting for frames, oldest at pending_head_: a ring allocated at construction, so that
   // grouping allocates nothing per set (rig thread only).

@@ -24,18 +24,13 @@
 
 namespace fieldrig::gps {
 
-struct LiveTriggerOptions {
-  TriggerOptions planner;
-  double latency_s = 0.05;  // nominal receiver-and-serial latency (see ReplayOptions)
-};
-
 class LiveTriggerChain {
  public:
   using TriggerHandler = std::function<void(const core::TriggerEvent&, core::SteadyTime fired_at)>;
   using AlarmHandler = std::function<void(const PlannerAlarm&)>;
   using FixHandler = std::function<void(const core::GpsFix&)>;
 
-  LiveTriggerChain(boost::asio::io_context& io, const LocationMap& map, LiveTriggerOptions options,
+  LiveTriggerChain(boost::asio::io_context& io, const LocationMap& map, TriggerChainOptions options,
                    TriggerHandler on_trigger, AlarmHandler on_alarm = {}, FixHandler on_fix = {});
 
   // Feed every sentence as it arrives (SerialNmeaSource's handler).
@@ -53,7 +48,7 @@ class LiveTriggerChain {
   void fireDue(core::SteadyTime now);
 
   boost::asio::steady_timer timer_;
-  LiveTriggerOptions options_;
+  TriggerChainOptions options_;
   TriggerHandler on_trigger_;
   AlarmHandler on_alarm_;
   FixHandler on_fix_;

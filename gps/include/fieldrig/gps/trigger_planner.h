@@ -42,6 +42,15 @@ struct TriggerOptions {
   double trigger_lead_s = 0.0;  // fire this much before the crossing (camera exposure delay)
 };
 
+// The planner's options and the receiver-to-host latency: what replay (in GPS time) and the live
+// chain (on a steady timer) both need.
+struct TriggerChainOptions {
+  TriggerOptions planner;
+  // Receiver and serial latency: from the fix's time to its last byte reaching the host. RTK
+  // receivers output 20-50 ms after the epoch, and two sentences take ~10 ms at 115200 baud.
+  double latency_s = 0.05;
+};
+
 enum class AlarmKind {
   kTooFast,  // two triggers closer than min_trigger_interval_s: one was delayed
   kMissed,   // a location was passed without a trigger (gap, invalid or stale fixes)

@@ -15,13 +15,6 @@
 
 namespace fieldrig::gps {
 
-struct ReplayOptions {
-  TriggerOptions planner;
-  // Receiver and serial latency: from the fix's time to its last byte reaching the host. RTK
-  // receivers output 20-50 ms after the epoch, and two sentences take ~10 ms at 115200 baud.
-  double latency_s = 0.05;
-};
-
 struct ReplaySummary {
   NmeaStats nmea;
   TriggerStats planner;
@@ -33,6 +26,6 @@ struct ReplayHandlers {
 };
 
 ReplaySummary replayTriggers(std::istream& nmea, const LocationMap& map,
-                             const ReplayOptions& options, const ReplayHandlers& handlers);
+                             const TriggerChainOptions& options, const ReplayHandlers& handlers);
 
 }  // namespace fieldrig::gps

@@ -46,6 +46,11 @@ struct FrameSetRecord {
   std::optional<std::string> location_id;  // the map's imaging location; none for manual triggers
   std::optional<core::GpsFix> fix;         // the fix the trigger was planned on, if any
   core::UtcTime trigger_time{};            // GPS time at which the trigger fired
+  // From the planner's trigger event, when a location asked for the set: the predicted crossing,
+  // when the rig sent the trigger (host clock), and "on_time" or "late".
+  std::optional<core::UtcTime> planned_time;
+  std::optional<core::UtcTime> sent_time;
+  std::optional<std::string> trigger_status;
   std::vector<FrameView> frames;
   bool complete = true;  // every camera delivered an ok frame
   double skew_us = 0;    // spread of the frames' device timestamps

@@ -78,6 +78,11 @@ struct IndexedSet {
   std::optional<std::string> location_id;
   std::optional<core::GpsFix> fix;  // its reception stamp is not recorded
   core::UtcTime trigger_time{};
+  // From the planner's trigger event, when a location asked for the set: the predicted crossing,
+  // when the rig sent the trigger (host clock), and "on_time" or "late".
+  std::optional<core::UtcTime> planned_time;
+  std::optional<core::UtcTime> sent_time;
+  std::optional<std::string> trigger_status;
   bool complete = true;
   double skew_us = 0;
   std::vector<IndexedFrame> frames;

@@ -1,0 +1,107 @@
+#include "fieldrig/core/durable_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+
+namespace fieldrig::core {
+
+int writeFully(int fd, const void* data, std::size_t size) {
+  const auto* bytes = static_cast<const std::uint8_t*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd, bytes, size);
+    if (n < 0) {
+      if (errno == EINTR)
+        continue;
+      return errno;
+    }
+    if (n == 0)
+      return EIO;
+    bytes += n;
+    size -= static_cast<std::size_t>(n);
+  }
+  return 0;
+}
+
+int syncDirectory(const std::filesystem::path& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0)
+    return errno;
+  const int result = ::fsync(fd) == 0 ? 0 : errno;
+  ::close(fd);
+  return result;
+}
+
+std::optional<std::string> readWholeFile(const std::filesystem::path& path, std::string& error) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    error = path.string() + ": cannot open: " + std::strerror(errno);
+    return std::nullopt;
+  }
+  std::string content;
+  struct stat info {};
+  if (::fstat(fd, &info) == 0 && info.st_size > 0)
+    content.reserve(static_cast<std::size_t>(info.st_size));
+  std::array<char, 65536> buffer;
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer.data(), buffer.size());
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n < 0) {
+      error = path.string() + ": cannot read: " + std::strerror(errno);
+      ::close(fd);
+      return std::nullopt;
+    }
+    if (n == 0)
+      break;
+    content.append(buffer.data(), static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  return content;
+}
+
+std::string replaceFileAtomically(const std::filesystem::path& path, std::string_view text) {
+  const std::filesystem::path temp = path.string() + ".tmp";
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    return temp.string() + ": cannot create: " + std::strerror(errno);
+  int error = writeFully(fd, text.data(), text.size());
+  if (error == 0 && ::fsync(fd) != 0)
+    error = errno;
+  ::close(fd);
+  if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0)
+    error = errno;
+  if (error != 0) {
+    ::unlink(temp.c_str());
+    return path.string() + ": cannot write: " + std::strerror(error);
+  }
+  if (const int sync_error = syncDirectory(path.parent_path()); sync_error != 0)
+    return path.parent_path().string() + ": cannot sync: " + std::strerror(sync_error);
+  return {};
+}
+
+std::string appendDurably(const std::filesystem::path& path, std::string_view text) {
+  const bool existed = std::filesystem::exists(path);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0)
+    return path.string() + ": cannot open for appending: " + std::strerror(errno);
+  int error = writeFully(fd, text.data(), text.size());
+  if (error == 0 && ::fdatasync(fd) != 0)
+    error = errno;
+  ::close(fd);
+  if (error != 0)
+    return path.string() + ": cannot append: " + std::strerror(error);
+  // A new file's name must reach the disk too, or a power loss can take the whole file.
+  if (!existed) {
+    if (const int sync_error = syncDirectory(path.parent_path()); sync_error != 0)
+      return path.parent_path().string() + ": cannot sync: " + std::strerror(sync_error);
+  }
+  return {};
+}
+
+}  // namespace fieldrig::core
