@@ -1,10 +1,13 @@
-#include "commands/session_frames.h"
+#include "fieldrig/daemon/head_frames.h"
+
+#include "fieldrig/core/rig_layout.h"
 
 #include <algorithm>
+#include <span>
 
-namespace fieldrig::tools {
+namespace fieldrig::daemon {
 
-core::Result<std::vector<cloud::HeadFrames>> framesFromSession(
+core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
     const recording::SessionReader& reader, std::uint64_t set_index, const cloud::RigConfig& rig,
     std::vector<std::string>& problems) {
   const recording::IndexedSet* set = reader.bySetIndex(set_index);
@@ -15,8 +18,11 @@ core::Result<std::vector<cloud::HeadFrames>> framesFromSession(
   std::vector<cloud::HeadFrames> frames;
   for (const cloud::HeadConfig& head : rig.heads) {
     cloud::HeadFrames head_frames;
-    for (const auto& [camera, image] : {std::pair{head.leftCamera(), &head_frames.left},
-                                        std::pair{head.rightCamera(), &head_frames.right}}) {
+    for (const auto& [camera, image] :
+         {std::pair{core::RigLayout::cameraName(head.name, core::CameraSide::kLeft),
+                    &head_frames.left},
+          std::pair{core::RigLayout::cameraName(head.name, core::CameraSide::kRight),
+                    &head_frames.right}}) {
       const auto it = std::find_if(set->frames.begin(), set->frames.end(),
                                    [&](const auto& f) { return f.camera_name == camera; });
       if (it == set->frames.end()) {
@@ -36,6 +42,47 @@ core::Result<std::vector<cloud::HeadFrames>> framesFromSession(
       }
       *image = cv::Mat(loaded->height, loaded->width, CV_8UC1, loaded->pixels.data()).clone();
       head_frames.pixel_format = it->pixel_format;
+    }
+    frames.push_back(std::move(head_frames));
+  }
+  return frames;
+}
+
+std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,
+                                                      const std::vector<std::string>& camera_names,
+                                                      const cloud::RigConfig& rig,
+                                                      std::vector<std::string>& problems) {
+  std::vector<cloud::HeadFrames> frames;
+  for (const cloud::HeadConfig& head : rig.heads) {
+    cloud::HeadFrames head_frames;
+    for (const auto& [camera, image] :
+         {std::pair{core::RigLayout::cameraName(head.name, core::CameraSide::kLeft),
+                    &head_frames.left},
+          std::pair{core::RigLayout::cameraName(head.name, core::CameraSide::kRight),
+                    &head_frames.right}}) {
+      const auto it = std::find(camera_names.begin(), camera_names.end(), camera);
+      const auto index = static_cast<std::size_t>(it - camera_names.begin());
+      if (it == camera_names.end() || index >= set.camera_count) {
+        problems.push_back(camera + ": not in the rig");
+        continue;
+      }
+      const core::Frame& frame = set.frames[index];
+      if (frame.metadata.status != core::FrameStatus::kOk || !frame.buffer) {
+        problems.push_back(camera + ": " + std::string(recording::toString(frame.metadata.status)));
+        continue;
+      }
+      const std::span<std::uint8_t> bytes = frame.buffer.bytes();
+      const std::size_t stride =
+          frame.metadata.stride ? frame.metadata.stride : frame.metadata.width;
+      if (bytes.size() < stride * frame.metadata.height) {
+        problems.push_back(camera + ": frame shorter than its size says");
+        continue;
+      }
+      // A header over the pool's buffer: the matcher only reads it (it debayers into images of
+      // its own), and the set holds the buffer until processing is done.
+      *image = cv::Mat(static_cast<int>(frame.metadata.height),
+                       static_cast<int>(frame.metadata.width), CV_8UC1, bytes.data(), stride);
+      head_frames.pixel_format = frame.metadata.format;
     }
     frames.push_back(std::move(head_frames));
   }
@@ -71,4 +118,4 @@ core::Result<cloud::RigConfig> loadRigFor(const std::string& explicit_dir,
   return cloud::loadRig(*dir);
 }
 
-}  // namespace fieldrig::tools
+}  // namespace fieldrig::daemon

@@ -8,7 +8,6 @@
 #include <random>
 
 #include "fieldrig/traits/plot_traits.h"
-#include "fieldrig/traits/traits_config.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig::traits {
@@ -146,31 +145,7 @@ TEST(VoxelDownsample, ShiftedGridKeepsTheGeometry) {
     EXPECT_NEAR(p.z(), 1.0F, 1e-5F);
 }
 
-TEST(TraitsConfig, ReadsKnownKeysAndNamesUnknownOnes) {
-  testing_support::ScopedTempDir dir("traits_config");
-  const auto good = dir / "good.json";
-  std::ofstream(good) << R"({"alpha": 0.25, "slices": 12, "area_method": "paper_mls_gpt",
-                             "camera_to_plot": [[1,0,0],[0,1,0],[0,0,1]]})";
-  core::Result<TraitsOptions> loaded = loadTraitsOptions(good.string());
-  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
-  EXPECT_DOUBLE_EQ(loaded->alpha, 0.25);
-  EXPECT_EQ(loaded->slices, 12);
-  EXPECT_EQ(loaded->area_method, AreaMethod::kPaperMlsGpt);
-  EXPECT_TRUE(loaded->camera_to_plot.isIdentity());
-
-  const auto unknown = dir / "unknown.json";
-  std::ofstream(unknown) << R"({"alpha": 0.3, "alhpa": 0.2})";
-  core::Result<TraitsOptions> bad = loadTraitsOptions(unknown.string());
-  ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.error().message.find("alhpa"), std::string::npos);
-  EXPECT_NE(bad.error().message.find("unknown.json"), std::string::npos);
-
-  const auto typed = dir / "typed.json";
-  std::ofstream(typed) << R"({"slices": "twenty"})";
-  core::Result<TraitsOptions> ill = loadTraitsOptions(typed.string());
-  ASSERT_FALSE(ill.ok());
-  EXPECT_NE(ill.error().message.find("slices"), std::string::npos);
-}
+// The traits options file is read by config::loadTraitsOptions: tests/config/config_test.cpp.
 
 }  // namespace
 }  // namespace fieldrig::traits

@@ -1,23 +1,25 @@
-// `fieldrig process SESSION [--calib DIR] [--map MAP.csv] [--traits-config FILE] [--out DIR]`:
-// every FrameSet of a recorded session through the whole pipeline (three heads → fused cloud →
-// plot traits), written as OUT/plots.csv and OUT/plots.geojson (one feature per plot, QGIS opens
-// both) and one JSON line per set on stdout. A set that cannot be processed is reported with its
-// status and kept in the outputs; it never stops the run.
-#include <algorithm>
-#include <chrono>
+// `fieldrig process SESSION [--calib DIR] [--map MAP.csv] [--traits-config FILE] [--out DIR]
+//  [--shard K/N] [--force] [--clouds]`: every FrameSet of a recorded session through the plot
+// processor (three heads → fused cloud → plot traits), the daemon's own, into the results folder
+// (plots.jsonl, plots.csv, plots.geojson; daemon/results_writer.h) and one JSON line per set on
+// stdout. It resumes: sets already in the folder's plots.jsonl (by trigger id) are skipped unless
+// --force. A set that cannot be processed is reported with its status and kept in the outputs;
+// it never stops the run.
+#include <charconv>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
 
 #include "commands/commands.h"
-#include "commands/session_frames.h"
 #include "fieldrig/cloud/fusion.h"
+#include "fieldrig/config/config.h"
 #include "fieldrig/core/time.h"
+#include "fieldrig/daemon/head_frames.h"
+#include "fieldrig/daemon/results_writer.h"
 #include "fieldrig/gps/location_map.h"
+#include "fieldrig/pipeline/plot_processor.h"
 #include "fieldrig/recording/session_reader.h"
-#include "fieldrig/traits/plot_report.h"
-#include "fieldrig/traits/traits_config.h"
 
 namespace fieldrig::tools {
 namespace {
@@ -26,44 +28,65 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 struct ProcessArgs {
-  std::string session, calib, map, traits_config, out;
+  std::string session, calib, map, traits_config, out, shard;
   bool clouds = false;
+  bool force = false;
 };
 
-// Where a set's plot is: its map location when the map knows it, else the fix at the trigger.
-std::optional<std::pair<double, double>> plotPosition(const recording::IndexedSet& set,
-                                                      const gps::LocationMap* map) {
-  if (map && set.location_id) {
-    if (const gps::ImagingLocation* location = map->find(*set.location_id)) {
-      return std::pair{location->latitude_deg, location->longitude_deg};
-    }
+struct Shard {
+  std::size_t index = 0;  // 0 … count-1
+  std::size_t count = 1;
+};
+
+// "K/N" with 0 ≤ K < N: this run takes every N-th set starting at the K-th, so shards get the
+// same number of sets (±1) whatever the sessions' lengths.
+std::optional<Shard> parseShard(const std::string& text) {
+  const auto slash = text.find('/');
+  if (slash == std::string::npos)
+    return std::nullopt;
+  Shard shard;
+  const char* begin = text.data();
+  const char* end = begin + text.size();
+  const auto k = std::from_chars(begin, begin + slash, shard.index);
+  const auto n = std::from_chars(begin + slash + 1, end, shard.count);
+  if (k.ec != std::errc{} || k.ptr != begin + slash || n.ec != std::errc{} || n.ptr != end ||
+      shard.count == 0 || shard.index >= shard.count) {
+    return std::nullopt;
   }
-  if (set.fix)
-    return std::pair{set.fix->latitude_deg, set.fix->longitude_deg};
-  return std::nullopt;
+  return shard;
 }
 
 int runProcess(const ProcessArgs& args) {
   const char* who = "fieldrig process: ";
+  Shard shard;
+  if (!args.shard.empty()) {
+    const auto parsed = parseShard(args.shard);
+    if (!parsed) {
+      std::cerr << who << "--shard '" << args.shard << "': expected K/N with 0 <= K < N\n";
+      return kExitBadInput;
+    }
+    shard = *parsed;
+  }
   auto opened = recording::SessionReader::open(args.session);
   if (!opened) {
     std::cerr << who << opened.error().message << '\n';
     return kExitBadInput;
   }
   const recording::SessionReader& reader = *opened;
-  auto rig = loadRigFor(args.calib, &reader);
+  auto rig = daemon::loadRigFor(args.calib, &reader);
   if (!rig) {
     std::cerr << who << rig.error().message << '\n';
     return kExitBadInput;
   }
-  traits::TraitsOptions options;
+  pipeline::ProcessorOptions options;
+  options.keep_cloud = args.clouds;
   if (!args.traits_config.empty()) {
-    auto loaded = traits::loadTraitsOptions(args.traits_config);
+    auto loaded = config::loadTraitsOptions(args.traits_config);
     if (!loaded) {
       std::cerr << who << loaded.error().message << '\n';
       return kExitBadInput;
     }
-    options = *loaded;
+    options.traits = *loaded;
   }
   std::optional<gps::LocationMap> map;
   if (!args.map.empty()) {
@@ -74,87 +97,84 @@ int runProcess(const ProcessArgs& args) {
     }
     map = std::move(*loaded);
   }
-  auto builder = cloud::CloudBuilder::create(*rig);
-  if (!builder) {
-    std::cerr << who << builder.error().message << '\n';
+  auto processor = pipeline::PlotProcessor::create(*rig, options);
+  if (!processor) {
+    std::cerr << who << processor.error().message << '\n';
     return kExitBadInput;
   }
-  const fs::path out_dir = args.out.empty() ? reader.dir() / "results" : fs::path(args.out);
-  std::error_code ec;
-  fs::create_directories(out_dir, ec);
-  if (ec) {
-    std::cerr << who << out_dir.string() << ": cannot create folder: " << ec.message() << '\n';
+  fs::path out_dir = args.out.empty() ? reader.dir() / "results" : fs::path(args.out);
+  if (args.out.empty() && shard.count > 1) {  // shards never write the same file
+    out_dir /= "shard-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count);
+  }
+  if (args.force) {
+    std::error_code ec;
+    for (const char* name : {"plots.jsonl", "plots.csv", "plots.geojson"})
+      fs::remove(out_dir / name, ec);
+  }
+  auto results = daemon::ResultsWriter::open(out_dir);
+  if (!results) {
+    std::cerr << who << results.error().message << '\n';
     return kExitBadInput;
   }
 
-  std::vector<traits::PlotRecord> records;
-  std::size_t ok_sets = 0;
-  std::size_t partial_clouds = 0;
-  std::size_t unplaced = 0;
-  for (const recording::IndexedSet& set : reader.sets()) {
+  std::size_t sets = 0, ok_sets = 0, partial_clouds = 0, unplaced = 0, skipped = 0;
+  for (std::size_t position = 0; position < reader.sets().size(); ++position) {
+    const recording::IndexedSet& set = reader.sets()[position];
+    if (position % shard.count != shard.index)
+      continue;
+    if ((*results)->contains(set.trigger_id)) {
+      ++skipped;
+      continue;
+    }
     std::vector<std::string> problems;
-    Json line;
-    line["set"] = set.set_index;
-    line["location"] = set.location_id ? Json(*set.location_id) : Json(nullptr);
-    auto frames = framesFromSession(reader, set.set_index, *rig, problems);
-    traits::PlotRecord record;
-    record.plot_id = set.location_id.value_or("set-" + std::to_string(set.set_index));
-    record.time = core::formatIso8601(set.trigger_time, 6);
-    if (const auto position = plotPosition(set, map ? &*map : nullptr)) {
-      std::tie(record.lat_deg, record.lon_deg) = *position;
-    } else {
-      ++unplaced;
-      problems.push_back("no map location and no fix: placed at 0,0");
-    }
+    auto frames = daemon::headFramesFromRecording(reader, set.set_index, *rig, problems);
+    pipeline::PlotResult result;
     if (frames) {
-      const cloud::FusionResult fused = builder->build(*frames);
-      partial_clouds += fused.partial() ? 1 : 0;
-      for (const cloud::HeadStatus& head : fused.heads) {
-        if (!head.ok)
-          problems.push_back("head " + head.name + " left out: " + head.problem);
-      }
-      std::vector<Eigen::Vector3f> points;
-      points.reserve(fused.cloud.size());
-      for (const auto& point : fused.cloud)
-        points.emplace_back(point.x, point.y, point.z);
-      if (args.clouds) {
-        const fs::path ply =
-            out_dir / (record.plot_id + "_set" + std::to_string(set.set_index) + ".ply");
-        if (auto written = cloud::writePly(fused.cloud, ply); !written) {
-          problems.push_back(written.error().message);
-        }
-      }
-      record.traits = traits::computeTraits(points, traits::InputFrame::kPlot, options);
-      line["cloud_points"] = fused.cloud.size();
-      line["partial"] = fused.partial();
+      result = processor->process(*frames, std::move(problems));
     } else {
-      problems.push_back(frames.error().message);
-      record.traits.status = traits::TraitsStatus::kEmptyCloud;
-      record.traits.message = frames.error().message;
+      result.problems = std::move(problems);
+      result.problems.push_back(frames.error().message);
+      result.traits.status = traits::TraitsStatus::kEmptyCloud;
+      result.traits.message = frames.error().message;
     }
-    ok_sets += record.traits.status == traits::TraitsStatus::kOk ? 1 : 0;
-    line["traits"] = traits::traitsToJson(record.traits, /*with_slices=*/false);
-    line["problems"] = problems;
+    daemon::PlotIdentity identity;
+    identity.set_index = set.set_index;
+    identity.trigger_id = set.trigger_id;
+    identity.location_id = set.location_id;
+    identity.time = core::formatIso8601(set.trigger_time, 6);
+    identity.position = daemon::plotPosition(set.location_id, set.fix, map ? &*map : nullptr);
+    identity.trigger_status = set.trigger_status.value_or("");
+    const Json line = daemon::plotLine(identity, result);
+    if (args.clouds && frames) {
+      const fs::path ply = out_dir / (line.at("plot").get<std::string>() + "_set" +
+                                      std::to_string(set.set_index) + ".ply");
+      if (auto written = cloud::writePly(result.cloud, ply); !written)
+        std::cerr << who << written.error().message << '\n';
+    }
+    ++sets;
+    ok_sets += result.traits.status == traits::TraitsStatus::kOk ? 1 : 0;
+    partial_clouds += result.partial ? 1 : 0;
+    unplaced += identity.position ? 0 : 1;
     std::cout << line.dump() << std::endl;
-    records.push_back(std::move(record));
-  }
-
-  const fs::path csv = out_dir / "plots.csv";
-  const fs::path geojson = out_dir / "plots.geojson";
-  for (const auto& [path, text] : {std::pair{csv, traits::formatCsv(records)},
-                                   std::pair{geojson, traits::formatGeoJson(records)}}) {
-    if (auto written = traits::writeText(path.string(), text); !written) {
-      std::cerr << who << written.error().message << '\n';
+    if (const std::string failed = (*results)->add(line); !failed.empty()) {
+      std::cerr << who << failed << '\n';
       return kExitRuntime;
     }
   }
+  if (const std::string failed = (*results)->flush(); !failed.empty()) {
+    std::cerr << who << failed << '\n';
+    return kExitRuntime;
+  }
   Json summary;
-  summary["sets"] = records.size();
+  summary["sets"] = sets;
   summary["ok"] = ok_sets;
   summary["partial_clouds"] = partial_clouds;
   summary["unplaced"] = unplaced;
-  summary["csv"] = csv.string();
-  summary["geojson"] = geojson.string();
+  summary["already_done"] = skipped;
+  summary["plots_in_results"] = (*results)->plots();
+  summary["csv"] = (out_dir / "plots.csv").string();
+  summary["geojson"] = (out_dir / "plots.geojson").string();
+  summary["jsonl"] = (out_dir / "plots.jsonl").string();
   std::cout << Json{{"summary", summary}}.dump() << std::endl;
   return kExitOk;
 }
@@ -170,8 +190,16 @@ void registerProcessCommand(CLI::App& app, int& exit_code) {
                       "Calibration folder (rig.yml + one folder per head); default: the "
                       "session's calib_dir reference");
   process->add_option("--map", args->map, "Location map: plots placed at their map location");
-  process->add_option("--traits-config", args->traits_config, "Traits options (JSON)");
-  process->add_option("--out", args->out, "Output folder (default SESSION/results)");
+  process->add_option("--traits-config", args->traits_config,
+                      "Traits options (YAML or JSON: the keys of pipeline.traits)");
+  process->add_option("--out", args->out,
+                      "Output folder (default SESSION/results, or SESSION/results/shard-K-of-N)");
+  process->add_option("--shard", args->shard,
+                      "Process every N-th set starting at the K-th (0 <= K < N), e.g. "
+                      "$SLURM_ARRAY_TASK_ID/N");
+  process->add_flag("--force", args->force,
+                    "Process every set again (default: resume, skipping the sets already in the "
+                    "results)");
   process->add_flag("--clouds", args->clouds, "Also write each set's fused cloud as PLY");
   process->callback([args, &exit_code] { exit_code = runProcess(*args); });
 }

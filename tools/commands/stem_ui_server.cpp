@@ -35,8 +35,8 @@
 #include <vector>
 
 #include "commands/commands.h"
-#include "commands/session_frames.h"
 #include "commands/stem_support.h"
+#include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/recording/session_reader.h"
 #include "fieldrig/stem/measurement_log.h"
 #include "fieldrig/stem/stem_measurer.h"
@@ -215,7 +215,7 @@ class StemUiServer {
   // intrinsics.yml and extrinsics.yml; relative paths are relative to the session folder).
   stereo::StereoCalibration calibration(const OpenSession& s, const std::string& head) {
     std::vector<fs::path> candidates;
-    if (const auto rig_dir = sessionCalibrationDir(args_.calib, *s.reader))
+    if (const auto rig_dir = daemon::sessionCalibrationDir(args_.calib, *s.reader))
       candidates.push_back(*rig_dir / head);
     for (const recording::CalibrationReference& ref : s.reader->metadata().calibration) {
       if (ref.name == head || ref.name == "head_" + head || ref.name == "stereo_" + head) {

@@ -19,10 +19,10 @@
 #include <sstream>
 
 #include "commands/commands.h"
-#include "commands/session_frames.h"
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/cloud/rig.h"
 #include "fieldrig/core/time.h"
+#include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/recording/session_reader.h"
 #include "fieldrig/stereo/calibrate.h"
 #include "fieldrig/stereo/calibration.h"
@@ -346,7 +346,7 @@ int runCloud(const CloudArgs& args) {
     }
     reader = std::move(*opened);
   }
-  auto rig = loadRigFor(args.calib, reader ? &*reader : nullptr);
+  auto rig = daemon::loadRigFor(args.calib, reader ? &*reader : nullptr);
   if (!rig) {
     std::cerr << who << rig.error().message << '\n';
     return kExitBadInput;
@@ -354,7 +354,8 @@ int runCloud(const CloudArgs& args) {
   std::vector<std::string> problems;
   std::vector<cloud::HeadFrames> frames;
   if (reader) {
-    auto loaded = framesFromSession(*reader, static_cast<std::uint64_t>(args.set), *rig, problems);
+    auto loaded = daemon::headFramesFromRecording(*reader, static_cast<std::uint64_t>(args.set),
+                                                  *rig, problems);
     if (!loaded) {
       std::cerr << who << loaded.error().message << '\n';
       return kExitBadInput;

@@ -14,30 +14,30 @@ Json numberOrNull(double value, bool valid) {
   return valid && std::isfinite(value) ? Json(value) : Json(nullptr);
 }
 
-// The flat properties shared by CSV and GeoJSON: one value per column, in a fixed order.
-Json flatProperties(const PlotRecord& record) {
-  const TraitsResult& r = record.traits;
-  const bool hw = r.heightWidthValid();
-  const bool vol = r.volumeValid();
+// The flat properties shared by CSV and GeoJSON, one value per column in a fixed order, taken
+// from the traits' JSON (traitsToJson): one mapping, so a row read back from a results file is
+// the row that was written.
+Json flatFromTraitsJson(const std::string& plot_id, const std::string& time, const Json& t) {
+  const Json& q = t.at("quality");
   Json p;
-  p["plot_id"] = record.plot_id;
-  p["time"] = record.time;
-  p["status"] = statusName(r.status);
-  p["height_m"] = numberOrNull(r.height_m, hw);
-  p["width_m"] = numberOrNull(r.width_m, hw);
-  p["vvi"] = numberOrNull(r.vvi, vol);
-  p["vai"] = numberOrNull(r.vai, vol && r.quality.area_computed);
-  p["total_volume_m3"] = numberOrNull(r.total_volume_m3, vol);
-  p["total_area_m2"] = numberOrNull(r.total_area_m2, vol && r.quality.area_computed);
-  p["ega_m2"] = numberOrNull(r.ega_m2, vol);
-  p["slices"] = r.quality.slices;
-  p["valid_slices"] = r.quality.valid_slices;
-  p["alpha_margin"] = r.quality.alpha_margin;
-  p["points_in"] = r.quality.points_in;
-  p["points_plants"] = r.quality.points_plants;
-  p["icp_fitness_fine"] = r.quality.icp_fitness_fine;
-  p["ground_tilt_deg"] = r.quality.ground_tilt_deg;
+  p["plot_id"] = plot_id;
+  p["time"] = time;
+  for (const char* key : {"status", "height_m", "width_m", "vvi", "vai", "total_volume_m3",
+                          "total_area_m2", "ega_m2"}) {
+    p[key] = t.at(key);
+  }
+  p["slices"] = q.at("slices");
+  p["valid_slices"] = t.at("valid_slices");
+  for (const char* key :
+       {"alpha_margin", "points_in", "points_plants", "icp_fitness_fine", "ground_tilt_deg"}) {
+    p[key] = q.at(key);
+  }
   return p;
+}
+
+Json flatProperties(const PlotRecord& record) {
+  return flatFromTraitsJson(record.plot_id, record.time,
+                            traitsToJson(record.traits, /*with_slices=*/false));
 }
 
 std::string csvField(const Json& value) {
@@ -126,7 +126,21 @@ nlohmann::ordered_json traitsToJson(const TraitsResult& r, bool with_slices) {
   return j;
 }
 
-std::string formatCsv(const std::vector<PlotRecord>& records) {
+PlotRow toPlotRow(const PlotRecord& record) {
+  return PlotRow{record.lat_deg, record.lon_deg, flatProperties(record)};
+}
+
+core::Result<PlotRow> plotRowFromJson(const std::string& plot_id, const std::string& time,
+                                      double lat_deg, double lon_deg,
+                                      const nlohmann::ordered_json& traits_json) {
+  try {
+    return PlotRow{lat_deg, lon_deg, flatFromTraitsJson(plot_id, time, traits_json)};
+  } catch (const nlohmann::json::exception& error) {
+    return core::Error{std::string("traits: ") + error.what()};
+  }
+}
+
+std::string formatCsv(const std::vector<PlotRow>& rows) {
   std::ostringstream out;
   out << std::setprecision(10);
   const Json header = flatProperties(PlotRecord{});
@@ -136,34 +150,52 @@ std::string formatCsv(const std::vector<PlotRecord>& records) {
       out << ',' << key;
   }
   out << '\n';
-  for (const PlotRecord& record : records) {
-    const Json p = flatProperties(record);
-    out << csvField(p["plot_id"]) << ',' << Json(record.lat_deg).dump() << ','
-        << Json(record.lon_deg).dump();
-    for (const auto& [key, value] : p.items()) {
+  for (const PlotRow& row : rows) {
+    const Json& p = row.properties;
+    out << csvField(p.value("plot_id", Json(""))) << ',' << Json(row.lat_deg).dump() << ','
+        << Json(row.lon_deg).dump();
+    for (const auto& [key, value] : header.items()) {
       if (key != "plot_id")
-        out << ',' << csvField(value);
+        out << ',' << csvField(p.contains(key) ? p.at(key) : Json(nullptr));
     }
     out << '\n';
   }
   return out.str();
 }
 
-std::string formatGeoJson(const std::vector<PlotRecord>& records) {
+std::string formatGeoJson(const std::vector<PlotRow>& rows) {
   Json collection;
   collection["type"] = "FeatureCollection";
   Json features = Json::array();
-  for (const PlotRecord& record : records) {
+  for (const PlotRow& row : rows) {
     Json feature;
     feature["type"] = "Feature";
-    feature["id"] = record.plot_id;
+    feature["id"] = row.properties.value("plot_id", Json(""));
     // RFC 7946 section 3.1.1: longitude first.
-    feature["geometry"] = {{"type", "Point"}, {"coordinates", {record.lon_deg, record.lat_deg}}};
-    feature["properties"] = flatProperties(record);
+    feature["geometry"] = {{"type", "Point"}, {"coordinates", {row.lon_deg, row.lat_deg}}};
+    feature["properties"] = row.properties;
     features.push_back(std::move(feature));
   }
   collection["features"] = std::move(features);
   return collection.dump(1) + "\n";
+}
+
+namespace {
+std::vector<PlotRow> toRows(const std::vector<PlotRecord>& records) {
+  std::vector<PlotRow> rows;
+  rows.reserve(records.size());
+  for (const PlotRecord& record : records)
+    rows.push_back(toPlotRow(record));
+  return rows;
+}
+}  // namespace
+
+std::string formatCsv(const std::vector<PlotRecord>& records) {
+  return formatCsv(toRows(records));
+}
+
+std::string formatGeoJson(const std::vector<PlotRecord>& records) {
+  return formatGeoJson(toRows(records));
 }
 
 core::Result<bool> writeText(const std::string& path, const std::string& text) {

@@ -1,5 +1,8 @@
-// A recorded FrameSet's frames as the cloud pipeline takes them, per head of the rig, and where a
-// session's calibration is. Shared by `fieldrig cloud`, `fieldrig process` and the stem tool.
+// The two adapters in front of the plot processor: a recorded set, or a live FrameSet, as the
+// per-head images it takes (in the order of the calibration's heads), and where a session's
+// calibration is. Cameras are found by the rig layout's names ("bottom_left"); one that is
+// absent, not ok or unreadable leaves its image empty and says why in `problems` (the cloud then
+// leaves the head out and names it).
 #pragma once
 
 #include <cstdint>
@@ -9,17 +12,23 @@
 #include <vector>
 
 #include "fieldrig/cloud/fusion.h"
+#include "fieldrig/core/frame.h"
 #include "fieldrig/core/result.h"
 #include "fieldrig/recording/session_reader.h"
 
-namespace fieldrig::tools {
+namespace fieldrig::daemon {
 
-// The frames of set `set_index`, in the order of rig.heads. A camera that is absent, not ok or
-// unreadable leaves its image empty and says why in `problems` (the cloud then flags the head);
-// only a set that does not exist is an error.
-core::Result<std::vector<cloud::HeadFrames>> framesFromSession(
+// The frames of recorded set `set_index`; only a set that does not exist is an error.
+core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
     const recording::SessionReader& reader, std::uint64_t set_index, const cloud::RigConfig& rig,
     std::vector<std::string>& problems);
+
+// The frames of a live set whose camera c is named camera_names[c]. The images point into the
+// set's pool buffers (no copy): keep the set alive while they are used.
+std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,
+                                                      const std::vector<std::string>& camera_names,
+                                                      const cloud::RigConfig& rig,
+                                                      std::vector<std::string>& problems);
 
 // `explicit_dir` when given, else the session's calibration reference named "calib_dir"
 // (relative to the session folder unless absolute); nullopt when neither exists.
@@ -31,4 +40,4 @@ std::optional<std::filesystem::path> sessionCalibrationDir(const std::string& ex
 core::Result<cloud::RigConfig> loadRigFor(const std::string& explicit_dir,
                                           const recording::SessionReader* reader);
 
-}  // namespace fieldrig::tools
+}  // namespace fieldrig::daemon

@@ -24,6 +24,23 @@ struct PlotRecord {
 // status, the quality fields, the slices and the timings.
 nlohmann::ordered_json traitsToJson(const TraitsResult& result, bool with_slices = true);
 
+// A plot as the tables show it: its position and its flat properties (plot_id, time, status, the
+// traits, the quality fields), one value per CSV column in a fixed order. Rows can be kept and
+// read back as JSON, which is how the results files are appended to across runs.
+struct PlotRow {
+  double lat_deg = 0.0;
+  double lon_deg = 0.0;
+  nlohmann::ordered_json properties;
+};
+
+PlotRow toPlotRow(const PlotRecord& record);
+// The row of a plot whose traits are known only as traitsToJson wrote them (a results file).
+core::Result<PlotRow> plotRowFromJson(const std::string& plot_id, const std::string& time,
+                                      double lat_deg, double lon_deg,
+                                      const nlohmann::ordered_json& traits_json);
+
+std::string formatCsv(const std::vector<PlotRow>& rows);
+std::string formatGeoJson(const std::vector<PlotRow>& rows);
 std::string formatCsv(const std::vector<PlotRecord>& records);
 std::string formatGeoJson(const std::vector<PlotRecord>& records);
 

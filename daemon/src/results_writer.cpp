@@ -1,0 +1,156 @@
+#include "fieldrig/daemon/results_writer.h"
+
+#include <sstream>
+
+#include "fieldrig/core/durable_file.h"
+
+namespace fieldrig::daemon {
+namespace {
+
+using Json = nlohmann::ordered_json;
+constexpr const char* kLinesFile = "plots.jsonl";
+
+Json optionalJson(const std::optional<std::string>& value) {
+  return value ? Json(*value) : Json(nullptr);
+}
+
+}  // namespace
+
+std::optional<std::pair<double, double>> plotPosition(const std::optional<std::string>& location_id,
+                                                      const std::optional<core::GpsFix>& fix,
+                                                      const gps::LocationMap* map) {
+  if (map && location_id) {
+    if (const gps::ImagingLocation* location = map->find(*location_id))
+      return std::pair{location->latitude_deg, location->longitude_deg};
+  }
+  if (fix)
+    return std::pair{fix->latitude_deg, fix->longitude_deg};
+  return std::nullopt;
+}
+
+nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::PlotResult& result) {
+  Json line;
+  line["set"] = identity.set_index ? Json(*identity.set_index) : Json(nullptr);
+  line["trigger_id"] = identity.trigger_id;
+  line["plot"] = identity.location_id.value_or(
+      identity.set_index ? "set-" + std::to_string(*identity.set_index)
+                         : "trigger-" + std::to_string(identity.trigger_id));
+  line["location"] = optionalJson(identity.location_id);
+  line["time"] = identity.time;
+  std::vector<std::string> problems = result.problems;
+  if (identity.position) {
+    line["lat"] = identity.position->first;
+    line["lon"] = identity.position->second;
+  } else {
+    line["lat"] = 0.0;
+    line["lon"] = 0.0;
+    problems.push_back("no map location and no fix: placed at 0,0");
+  }
+  line["trigger_status"] = identity.trigger_status;
+  line["cloud_points"] = result.cloud_points;
+  line["partial"] = result.partial;
+  Json traits_json = traits::traitsToJson(result.traits, /*with_slices=*/false);
+  // Timings are how long this machine took, not what the plot is: they stay out of the results,
+  // so that the same inputs give byte-identical files (benchmarks and the status report them).
+  traits_json.erase("timings_ms");
+  line["traits"] = std::move(traits_json);
+  line["problems"] = problems;
+  return line;
+}
+
+core::Result<std::unique_ptr<ResultsWriter>> ResultsWriter::open(const std::filesystem::path& dir,
+                                                                 ResultsOptions options) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec)
+    return core::Error{dir.string() + ": cannot create folder: " + ec.message()};
+  std::unique_ptr<ResultsWriter> writer(new ResultsWriter(dir, options));
+  const std::filesystem::path lines_path = dir / kLinesFile;
+  if (!std::filesystem::exists(lines_path))
+    return writer;
+  std::string error;
+  const std::optional<std::string> content = core::readWholeFile(lines_path, error);
+  if (!content)
+    return core::Error{error};
+  std::istringstream in(*content);
+  std::string text;
+  std::size_t line_number = 0;
+  std::size_t whole_bytes = 0;
+  while (std::getline(in, text)) {
+    ++line_number;
+    if (in.eof())  // no newline: an append cut short by a crash; the plot is processed again
+      break;
+    whole_bytes += text.size() + 1;
+    try {
+      const Json line = Json::parse(text);
+      auto row = traits::plotRowFromJson(
+          line.at("plot").get<std::string>(), line.at("time").get<std::string>(),
+          line.at("lat").get<double>(), line.at("lon").get<double>(), line.at("traits"));
+      if (!row)
+        throw std::runtime_error(row.error().message);
+      writer->rows_.push_back(std::move(*row));
+      writer->done_.insert(line.at("trigger_id").get<std::uint64_t>());
+    } catch (const std::exception& e) {
+      return core::Error{lines_path.string() + ":" + std::to_string(line_number) +
+                         ": not a result line: " + e.what()};
+    }
+  }
+  if (whole_bytes < content->size()) {
+    if (const std::string failed =
+            core::replaceFileAtomically(lines_path, content->substr(0, whole_bytes));
+        !failed.empty()) {
+      return core::Error{failed};
+    }
+  }
+  return writer;
+}
+
+ResultsWriter::~ResultsWriter() {
+  flush();
+}
+
+std::string ResultsWriter::add(const nlohmann::ordered_json& line) {
+  if (options_.jsonl) {
+    if (std::string failed = core::appendDurably(dir_ / kLinesFile, line.dump() + "\n");
+        !failed.empty()) {
+      return failed;
+    }
+  }
+  auto row = traits::plotRowFromJson(
+      line.at("plot").get<std::string>(), line.at("time").get<std::string>(),
+      line.at("lat").get<double>(), line.at("lon").get<double>(), line.at("traits"));
+  if (!row)
+    return row.error().message;
+  rows_.push_back(std::move(*row));
+  done_.insert(line.at("trigger_id").get<std::uint64_t>());
+  tables_stale_ = true;
+  if (std::chrono::steady_clock::now() - tables_written_ >= options_.table_interval)
+    return writeTables();
+  return {};
+}
+
+std::string ResultsWriter::flush() {
+  return tables_stale_ ? writeTables() : std::string();
+}
+
+std::string ResultsWriter::writeTables() {
+  tables_written_ = std::chrono::steady_clock::now();
+  tables_stale_ = false;
+  if (options_.csv) {
+    if (std::string failed =
+            core::replaceFileAtomically(dir_ / "plots.csv", traits::formatCsv(rows_));
+        !failed.empty()) {
+      return failed;
+    }
+  }
+  if (options_.geojson) {
+    if (std::string failed =
+            core::replaceFileAtomically(dir_ / "plots.geojson", traits::formatGeoJson(rows_));
+        !failed.empty()) {
+      return failed;
+    }
+  }
+  return {};
+}
+
+}  // namespace fieldrig::daemon
