@@ -12,12 +12,12 @@
 
 #include "commands/commands.h"
 #include "fieldrig/cloud/fusion.h"
+#include "fieldrig/config/config.h"
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/traits/cloud_io.h"
 #include "fieldrig/traits/plot_report.h"
 #include "fieldrig/traits/plot_traits.h"
-#include "fieldrig/traits/traits_config.h"
 
 namespace fieldrig::tools {
 namespace {
@@ -49,7 +49,7 @@ struct SynthArgs {
 int runTraits(const TraitsArgs& args) {
   traits::TraitsOptions options;
   if (!args.config.empty()) {
-    core::Result<traits::TraitsOptions> loaded = traits::loadTraitsOptions(args.config);
+    core::Result<traits::TraitsOptions> loaded = config::loadTraitsOptions(args.config);
     if (!loaded) {
       std::cerr << "fieldrig traits: " << loaded.error().message << '\n';
       return kExitBadInput;
@@ -162,7 +162,9 @@ void registerTraitsCommand(CLI::App& app, int& exit_code) {
   traits_app->add_option("--frame", args->frame, "plot (x up, y row, z depth) or camera")
       ->check(CLI::IsMember({"plot", "camera"}))
       ->capture_default_str();
-  traits_app->add_option("--config", args->config, "Traits options (JSON)")
+  traits_app
+      ->add_option("--config", args->config,
+                   "Traits options (YAML or JSON: the keys of pipeline.traits)")
       ->check(CLI::ExistingFile);
   traits_app->add_option("--area", args->area, "Surface for VAI: depth_map (default) or paper")
       ->check(CLI::IsMember({"depth_map", "paper"}));
