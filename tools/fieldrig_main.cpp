@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   fieldrig::tools::registerTraitsCommand(app, exit_code);
   fieldrig::tools::registerStemCommands(app, exit_code);
   fieldrig::tools::registerProcessCommand(app, exit_code);
+  fieldrig::tools::registerSimulateCommand(app, exit_code);
   CLI11_PARSE(app, argc, argv);
   return exit_code;
 }

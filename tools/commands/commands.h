@@ -23,5 +23,7 @@ void registerStemCommands(CLI::App& app, int& exit_code);  // stem, stem-ui
 void registerProcessCommand(CLI::App& app, int& exit_code);
 // `sim plots`, added to the `sim` subcommand by registerSimCommand.
 void registerSimPlotsSubcommand(CLI::App& sim, int& exit_code);
+// `simulate`: a synthetic field (drive, map, session, truth) to replay through fieldrigd.
+void registerSimulateCommand(CLI::App& app, int& exit_code);
 
 }  // namespace fieldrig::tools
