@@ -1,11 +1,30 @@
 #include "fieldrig/daemon/head_frames.h"
 
-#include "fieldrig/core/rig_layout.h"
-
 #include <algorithm>
 #include <span>
 
+#include "fieldrig/core/rig_layout.h"
+
 namespace fieldrig::daemon {
+namespace {
+
+// The head images in the order of rig.heads: `fill(camera name, image, pixel format)` loads one
+// camera's image, or leaves it empty and says why in the caller's problems.
+template <typename Fill>
+std::vector<cloud::HeadFrames> perHead(const cloud::RigConfig& rig, Fill fill) {
+  std::vector<cloud::HeadFrames> frames;
+  for (const cloud::HeadConfig& head : rig.heads) {
+    cloud::HeadFrames head_frames;
+    for (const auto& [side, image] : {std::pair{core::CameraSide::kLeft, &head_frames.left},
+                                      std::pair{core::CameraSide::kRight, &head_frames.right}}) {
+      fill(core::RigLayout::cameraName(head.name, side), *image, head_frames.pixel_format);
+    }
+    frames.push_back(std::move(head_frames));
+  }
+  return frames;
+}
+
+}  // namespace
 
 core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
     const recording::SessionReader& reader, std::uint64_t set_index, const cloud::RigConfig& rig,
@@ -15,78 +34,56 @@ core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
     return core::Error{reader.dir().string() + ": no set with index " + std::to_string(set_index) +
                        " (" + std::to_string(reader.sets().size()) + " sets)"};
   }
-  std::vector<cloud::HeadFrames> frames;
-  for (const cloud::HeadConfig& head : rig.heads) {
-    cloud::HeadFrames head_frames;
-    for (const auto& [camera, image] :
-         {std::pair{core::RigLayout::cameraName(head.name, core::CameraSide::kLeft),
-                    &head_frames.left},
-          std::pair{core::RigLayout::cameraName(head.name, core::CameraSide::kRight),
-                    &head_frames.right}}) {
-      const auto it = std::find_if(set->frames.begin(), set->frames.end(),
-                                   [&](const auto& f) { return f.camera_name == camera; });
-      if (it == set->frames.end()) {
-        problems.push_back(camera + ": not in set " + std::to_string(set_index));
-        continue;
-      }
-      if (it->status != recording::FrameStatus::kOk || it->file.empty()) {
-        problems.push_back(camera + ": recorded as " +
-                           std::string(recording::toString(it->status)) +
-                           (it->reason.empty() ? "" : " (" + it->reason + ")"));
-        continue;
-      }
-      auto loaded = reader.loadFrame(*it);
-      if (!loaded) {
-        problems.push_back(loaded.error().message);
-        continue;
-      }
-      *image = cv::Mat(loaded->height, loaded->width, CV_8UC1, loaded->pixels.data()).clone();
-      head_frames.pixel_format = it->pixel_format;
+  return perHead(rig, [&](const std::string& camera, cv::Mat& image, core::PixelFormat& format) {
+    const auto it = std::find_if(set->frames.begin(), set->frames.end(),
+                                 [&](const auto& f) { return f.camera_name == camera; });
+    if (it == set->frames.end()) {
+      problems.push_back(camera + ": not in set " + std::to_string(set_index));
+      return;
     }
-    frames.push_back(std::move(head_frames));
-  }
-  return frames;
+    if (it->status != recording::FrameStatus::kOk || it->file.empty()) {
+      problems.push_back(camera + ": recorded as " + std::string(recording::toString(it->status)) +
+                         (it->reason.empty() ? "" : " (" + it->reason + ")"));
+      return;
+    }
+    auto loaded = reader.loadFrame(*it);
+    if (!loaded) {
+      problems.push_back(loaded.error().message);
+      return;
+    }
+    image = cv::Mat(loaded->height, loaded->width, CV_8UC1, loaded->pixels.data()).clone();
+    format = it->pixel_format;
+  });
 }
 
 std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,
                                                       const std::vector<std::string>& camera_names,
                                                       const cloud::RigConfig& rig,
                                                       std::vector<std::string>& problems) {
-  std::vector<cloud::HeadFrames> frames;
-  for (const cloud::HeadConfig& head : rig.heads) {
-    cloud::HeadFrames head_frames;
-    for (const auto& [camera, image] :
-         {std::pair{core::RigLayout::cameraName(head.name, core::CameraSide::kLeft),
-                    &head_frames.left},
-          std::pair{core::RigLayout::cameraName(head.name, core::CameraSide::kRight),
-                    &head_frames.right}}) {
-      const auto it = std::find(camera_names.begin(), camera_names.end(), camera);
-      const auto index = static_cast<std::size_t>(it - camera_names.begin());
-      if (it == camera_names.end() || index >= set.camera_count) {
-        problems.push_back(camera + ": not in the rig");
-        continue;
-      }
-      const core::Frame& frame = set.frames[index];
-      if (frame.metadata.status != core::FrameStatus::kOk || !frame.buffer) {
-        problems.push_back(camera + ": " + std::string(recording::toString(frame.metadata.status)));
-        continue;
-      }
-      const std::span<std::uint8_t> bytes = frame.buffer.bytes();
-      const std::size_t stride =
-          frame.metadata.stride ? frame.metadata.stride : frame.metadata.width;
-      if (bytes.size() < stride * frame.metadata.height) {
-        problems.push_back(camera + ": frame shorter than its size says");
-        continue;
-      }
-      // A header over the pool's buffer: the matcher only reads it (it debayers into images of
-      // its own), and the set holds the buffer until processing is done.
-      *image = cv::Mat(static_cast<int>(frame.metadata.height),
-                       static_cast<int>(frame.metadata.width), CV_8UC1, bytes.data(), stride);
-      head_frames.pixel_format = frame.metadata.format;
+  return perHead(rig, [&](const std::string& camera, cv::Mat& image, core::PixelFormat& format) {
+    const auto it = std::find(camera_names.begin(), camera_names.end(), camera);
+    const auto index = static_cast<std::size_t>(it - camera_names.begin());
+    if (it == camera_names.end() || index >= set.camera_count) {
+      problems.push_back(camera + ": not in the rig");
+      return;
     }
-    frames.push_back(std::move(head_frames));
-  }
-  return frames;
+    const core::Frame& frame = set.frames[index];
+    if (frame.metadata.status != core::FrameStatus::kOk || !frame.buffer) {
+      problems.push_back(camera + ": " + std::string(recording::toString(frame.metadata.status)));
+      return;
+    }
+    const std::span<std::uint8_t> bytes = frame.buffer.bytes();
+    const std::size_t stride = frame.metadata.stride ? frame.metadata.stride : frame.metadata.width;
+    if (bytes.size() < stride * frame.metadata.height) {
+      problems.push_back(camera + ": frame shorter than its size says");
+      return;
+    }
+    // A header over the pool's buffer: the matcher only reads it (it debayers into images of its
+    // own), and the set holds the buffer until processing is done.
+    image = cv::Mat(static_cast<int>(frame.metadata.height), static_cast<int>(frame.metadata.width),
+                    CV_8UC1, bytes.data(), stride);
+    format = frame.metadata.format;
+  });
 }
 
 std::optional<std::filesystem::path> sessionCalibrationDir(const std::string& explicit_dir,

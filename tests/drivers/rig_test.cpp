@@ -142,7 +142,11 @@ TEST(RigTest, CorruptFramesAreDeliveredMarked) {
 }
 
 TEST(RigTest, BuffersReturnToThePoolWhenConsumersLetGo) {
-  auto rig = Rig::create(sixCameras(), CameraRegistry::instance());
+  RigOptions options = sixCameras();
+  // Every frame must arrive for the count below: a sim worker starved for 100 ms on a loaded
+  // 2-core machine (the test suite runs in parallel) would time its frame out as missing.
+  options.frame_timeout = 2s;
+  auto rig = Rig::create(options, CameraRegistry::instance());
   ASSERT_TRUE(rig.ok());
   Collector collector;
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());

@@ -48,12 +48,12 @@ inline std::string shellQuote(const std::string& text) {
   return quoted + "'";
 }
 
-// Runs `fieldrig ARGS…` to completion, capturing stdout and stderr through files in `work_dir`.
-inline CliRun runFieldrig(const std::vector<std::string>& args,
-                          const std::filesystem::path& work_dir) {
+// Runs `PROGRAM ARGS…` to completion, capturing stdout and stderr through files in `work_dir`.
+inline CliRun runProgram(const std::string& program, const std::vector<std::string>& args,
+                         const std::filesystem::path& work_dir) {
   const auto out = work_dir / "cli.out";
   const auto err = work_dir / "cli.err";
-  std::string command = shellQuote(kFieldrigBinary);
+  std::string command = shellQuote(program);
   for (const std::string& arg : args)
     command += " " + shellQuote(arg);
   command += " </dev/null >" + shellQuote(out.string()) + " 2>" + shellQuote(err.string());
@@ -64,6 +64,12 @@ inline CliRun runFieldrig(const std::vector<std::string>& args,
   run.err = readWholeFile(err);
   run.err_lines = splitLines(run.err);
   return run;
+}
+
+// Runs `fieldrig ARGS…` to completion.
+inline CliRun runFieldrig(const std::vector<std::string>& args,
+                          const std::filesystem::path& work_dir) {
+  return runProgram(kFieldrigBinary, args, work_dir);
 }
 
 }  // namespace fieldrig::testing_support

@@ -1,0 +1,45 @@
+// fieldrigd: the on-vehicle daemon. One run joins the parts along DESIGN.md's data flow:
+//
+//   NMEA (serial port, a pty, or a file) → planner → trigger events
+//        → Acquisition (rig → recorder, never dropped; → processing queue, skips counted)
+//        → PlotProcessor (stereo → fused cloud → traits) → ResultsWriter (JSONL, CSV, GeoJSON)
+//
+// Modes:
+//   run     live: the receiver on the configured serial port, the configured camera driver;
+//           triggers fire on a steady timer at the predicted crossings.
+//   replay  the sim cameras replay a recorded (or synthetic) session; NMEA comes from
+//           replay.nmea: a pty or serial device is read as in the field (real time), a file is
+//           played through a pty of the daemon's own at its own pace when replay.realtime is
+//           set, and otherwise replayed in virtual time — the planner runs in GPS time as fast as
+//           the machine allows, each trigger waiting until the rig, the recorder and processing
+//           have room, so no set is ever skipped and the same inputs give identical results.
+//
+// Threads: the GPS/trigger thread (serial, parser, planner, timers, signals) only posts trigger
+// events to lock-free queues; cameras, recording, processing and the status server run on
+// threads of their own, and a slow stdout reader stalls only the processing thread.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "fieldrig/config/config.h"
+
+namespace fieldrig::daemon {
+
+enum class Mode { kRun, kReplay };
+
+struct DaemonOptions {
+  config::Config config;
+  Mode mode = Mode::kRun;
+  bool print_results = true;  // one JSON line per plot on stdout, then a summary line
+};
+
+// Exit codes: 0 done (signal or end of replay), 2 bad configuration or input at start (nothing
+// written), 3 a failure while running.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitRuntime = 3;
+
+int runDaemon(const DaemonOptions& options);
+
+}  // namespace fieldrig::daemon

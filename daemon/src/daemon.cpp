@@ -1,0 +1,754 @@
+#include "fieldrig/daemon/daemon.h"
+
+#include <fcntl.h>
+#include <spdlog/spdlog.h>
+#include <sys/resource.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdlib>
+#include <deque>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
+
+#include "fieldrig/cloud/rig.h"
+#include "fieldrig/core/logging.h"
+#include "fieldrig/core/time.h"
+#include "fieldrig/daemon/acquisition.h"
+#include "fieldrig/daemon/head_frames.h"
+#include "fieldrig/daemon/results_writer.h"
+#include "fieldrig/daemon/status_server.h"
+#include "fieldrig/gps/live_trigger_chain.h"
+#include "fieldrig/gps/local_frame.h"
+#include "fieldrig/gps/location_map.h"
+#include "fieldrig/gps/serial_nmea_source.h"
+#include "fieldrig/gps/trigger_replay.h"
+#include "fieldrig/pipeline/plot_processor.h"
+#include "nmea_player.h"
+#include "service_notifier.h"
+
+namespace fieldrig::daemon {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+constexpr auto kHousekeepingPeriod = std::chrono::milliseconds{200};
+constexpr double kGpsLostAfterS = 1.0;  // ten missed 10 Hz epochs
+constexpr std::size_t kAlarmsKept = 100;
+constexpr double kSpeedWarnRatio = 0.8;  // amber at 80 % of what the cameras can keep up with
+constexpr auto kFinishTimeout = std::chrono::seconds{10};
+
+struct RowCounts {
+  std::uint64_t locations = 0, fired = 0, late = 0, missed = 0;
+};
+
+// Resident memory now and at its peak, MB (Linux: /proc/self/statm and getrusage).
+std::pair<double, double> memoryMb() {
+  double rss = 0;
+  std::ifstream statm("/proc/self/statm");
+  std::size_t pages_total = 0, pages_resident = 0;
+  if (statm >> pages_total >> pages_resident)
+    rss = static_cast<double>(pages_resident) * static_cast<double>(::sysconf(_SC_PAGESIZE)) / 1e6;
+  rusage usage{};
+  ::getrusage(RUSAGE_SELF, &usage);
+  return {rss, static_cast<double>(usage.ru_maxrss) / 1e3};
+}
+
+std::string nowIso() {
+  return core::formatIso8601(core::UtcTime{std::chrono::duration_cast<core::Nanoseconds>(
+                                 std::chrono::system_clock::now().time_since_epoch())},
+                             3);
+}
+
+// The fastest the tractor may drive before two locations of a row come closer in time than the
+// cameras' minimum trigger interval: the shortest spacing between neighbouring locations of a row
+// (maps list a row's locations in order; without a row column, all are one row) over that
+// interval. Linear in the map's size: season maps hold 100,000 locations.
+double maxSpeedFor(const gps::LocationMap& map, double min_trigger_interval_s) {
+  if (map.size() < 2 || min_trigger_interval_s <= 0)
+    return 0;
+  const auto& columns = map.metadataColumns();
+  const auto row_column = std::find(columns.begin(), columns.end(), "row");
+  const gps::LocalFrame frame(map.locations().front().latitude_deg,
+                              map.locations().front().longitude_deg);
+  auto rowOf = [&](const gps::ImagingLocation& location) {
+    if (row_column == columns.end())
+      return std::string();
+    const auto c = static_cast<std::size_t>(row_column - columns.begin());
+    return c < location.metadata.size() ? location.metadata[c] : std::string();
+  };
+  double shortest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < map.size(); ++i) {
+    const auto& a = map.locations()[i - 1];
+    const auto& b = map.locations()[i];
+    if (rowOf(a) != rowOf(b))
+      continue;
+    const gps::EnuPoint pa = frame.toLocal(a.latitude_deg, a.longitude_deg);
+    const gps::EnuPoint pb = frame.toLocal(b.latitude_deg, b.longitude_deg);
+    const double spacing = std::hypot(pa.east_m - pb.east_m, pa.north_m - pb.north_m);
+    if (spacing > 0)
+      shortest = std::min(shortest, spacing);
+  }
+  return std::isfinite(shortest) ? shortest / min_trigger_interval_s : 0;
+}
+
+class Daemon {
+ public:
+  explicit Daemon(const DaemonOptions& options) : options_(options), config_(options.config) {}
+
+  int run() {
+    if (const int failed = prepare(); failed != kExitOk)
+      return failed;
+    const fs::path& nmea =
+        options_.mode == Mode::kReplay ? config_.replay.nmea : fs::path(config_.gps.serial.device);
+    std::error_code ec;
+    const bool device = fs::is_character_file(nmea, ec);
+    if (options_.mode == Mode::kReplay && !device && !config_.replay.realtime) {
+      runVirtualTime(nmea);
+    } else {
+      runLive(nmea, /*play_file=*/!device);
+    }
+    return finish();
+  }
+
+ private:
+  // Everything that can fail on bad input, before anything is written: map, calibration,
+  // camera configuration, session folder.
+  int prepare() {
+    if (config_.map.empty()) {
+      spdlog::error("{}: map: no imaging-location map configured", sourceName());
+      return kExitBadInput;
+    }
+    auto map = gps::LocationMap::load(config_.map);
+    if (!map) {
+      spdlog::error("{}", map.error().message);
+      return kExitBadInput;
+    }
+    if (map->empty()) {
+      spdlog::error("{}: the map has no locations", config_.map.string());
+      return kExitBadInput;
+    }
+    map_ = std::move(*map);
+    const auto& columns = map_.metadataColumns();
+    const auto row_column = std::find(columns.begin(), columns.end(), "row");
+    for (const auto& location : map_.locations()) {
+      std::string row = "all";
+      if (row_column != columns.end()) {
+        const auto c = static_cast<std::size_t>(row_column - columns.begin());
+        if (c < location.metadata.size())
+          row = location.metadata[c];
+      }
+      location_rows_[location.id] = row;
+      ++rows_[row].locations;
+    }
+    max_speed_mps_ = maxSpeedFor(map_, config_.gps.triggers.planner.min_trigger_interval_s);
+
+    if (options_.mode == Mode::kReplay && config_.replay.nmea.empty()) {
+      spdlog::error("{}: replay.nmea: replay needs an NMEA file or device", sourceName());
+      return kExitBadInput;
+    }
+    if (options_.mode == Mode::kRun && config_.gps.serial.device.empty()) {
+      spdlog::error("{}: gps.serial.device: run needs the receiver's serial port", sourceName());
+      return kExitBadInput;
+    }
+    if (options_.mode == Mode::kReplay) {
+      std::error_code ec;
+      if (!fs::exists(config_.replay.nmea, ec)) {
+        spdlog::error("{}: replay.nmea: {}: no such file or device", sourceName(),
+                      config_.replay.nmea.string());
+        return kExitBadInput;
+      }
+    }
+    if (config_.recording.dir.empty()) {
+      spdlog::error("{}: recording.dir: no session folder configured", sourceName());
+      return kExitBadInput;
+    }
+    if (config_.pipeline.enabled) {
+      if (config_.calibration.empty()) {
+        spdlog::error(
+            "{}: calibration: processing needs the calibration folder (or set "
+            "pipeline.enabled: false)",
+            sourceName());
+        return kExitBadInput;
+      }
+      auto rig = cloud::loadRig(config_.calibration);
+      if (!rig) {
+        spdlog::error("{}", rig.error().message);
+        return kExitBadInput;
+      }
+      pipeline::ProcessorOptions processor_options;
+      processor_options.matcher = config_.pipeline.matcher;
+      processor_options.traits = config_.pipeline.traits;
+      auto processor = pipeline::PlotProcessor::create(*rig, processor_options);
+      if (!processor) {
+        spdlog::error("{}", processor.error().message);
+        return kExitBadInput;
+      }
+      processor_.emplace(std::move(*processor));
+    }
+
+    AcquisitionOptions acquisition;
+    acquisition.rig = config_.cameras.rig;
+    acquisition.layout = config_.cameras.layout;
+    if (options_.mode == Mode::kReplay && acquisition.rig.driver == "sim" &&
+        !config_.replay.session.empty()) {
+      for (auto& camera : acquisition.rig.cameras)
+        camera.options["session"] = config_.replay.session.string();
+    }
+    acquisition.session_dir = config_.recording.dir;
+    acquisition.writer = config_.recording.writer;
+    acquisition.processing_queue_sets = std::max<std::size_t>(1, config_.pipeline.queue_sets);
+    acquisition.session.configuration = {
+        {"recorded_by", "fieldrigd"},
+        {"mode", options_.mode == Mode::kRun ? "run" : "replay"},
+        {"config_file", config_.source.string()},
+        {"driver", acquisition.rig.driver},
+        {"nmea",
+         options_.mode == Mode::kRun ? config_.gps.serial.device : config_.replay.nmea.string()},
+        {"replayed_session", config_.replay.session.string()}};
+    acquisition.session.map_file = config_.map;
+    if (!config_.calibration.empty()) {
+      std::error_code ec;
+      acquisition.session.calibration.push_back(
+          {"calib_dir", fs::absolute(config_.calibration, ec).string()});
+    }
+    // Results are opened before the session, so that a results folder that cannot be used
+    // leaves nothing written.
+    const fs::path results_dir =
+        config_.outputs.dir.empty() ? config_.recording.dir / "results" : config_.outputs.dir;
+    ResultsOptions results_options;
+    results_options.csv = config_.outputs.csv;
+    results_options.geojson = config_.outputs.geojson;
+    results_options.jsonl = config_.outputs.jsonl;
+    if (processor_) {
+      auto results = ResultsWriter::open(results_dir, results_options);
+      if (!results) {
+        spdlog::error("{}", results.error().message);
+        return kExitBadInput;
+      }
+      results_ = std::move(*results);
+    }
+    // The status port is taken before the session is opened: a port in use leaves nothing written.
+    if (config_.status.enabled) {
+      auto server = StatusServer::start(config_.status.address, config_.status.port,
+                                        [this] { return snapshot(); });
+      if (!server) {
+        spdlog::error("{}", server.error().message);
+        return kExitBadInput;
+      }
+      status_ = std::move(*server);
+      spdlog::info("status on http://{}:{}/status", config_.status.address, status_->port());
+      std::cerr << Json{{"status_url", "http://" + config_.status.address + ":" +
+                                           std::to_string(status_->port()) + "/status"}}
+                       .dump()
+                << std::endl;
+    }
+    auto created = Acquisition::create(acquisition, drivers::CameraRegistry::instance());
+    if (!created) {
+      spdlog::error("{}", created.error().message);
+      return kExitBadInput;
+    }
+    acquisition_ = std::move(*created);
+    acquisition_ready_ = true;
+    Acquisition::ProcessSet process;
+    if (processor_)
+      process = [this](const core::FrameSet& set) { processSet(set); };
+    if (auto started = acquisition_->start(process); !started) {
+      spdlog::error("{}", started.error().message);
+      return kExitRuntime;
+    }
+    started_at_ = Clock::now();
+    spdlog::info("fieldrigd: {} mode, map {} ({} locations), session {}",
+                 options_.mode == Mode::kRun ? "run" : "replay", config_.map.string(), map_.size(),
+                 config_.recording.dir.string());
+    return kExitOk;
+  }
+
+  std::string sourceName() const {
+    return config_.source.empty() ? std::string("configuration") : config_.source.string();
+  }
+
+  // ---- GPS/trigger thread -------------------------------------------------------------------
+
+  void onTrigger(const core::TriggerEvent& event) {
+    if (recording_stopped_alarmed_ == false && acquisition_->stats().recording_stopped) {
+      recording_stopped_alarmed_ = true;
+      alarm("recording_stopped", acquisition_->stats().alarm, "");
+    }
+    const bool accepted = acquisition_->trigger(event);
+    std::lock_guard lock(health_mutex_);
+    ++triggers_;
+    RowCounts& row = rows_[rowOf(event.location_id)];
+    ++row.fired;
+    if (event.status == core::TriggerStatus::kLate) {
+      ++late_;
+      ++row.late;
+    }
+    if (!accepted)
+      ++refused_;
+    last_trigger_ = event;
+  }
+
+  void onPlannerAlarm(const gps::PlannerAlarm& planner_alarm) {
+    const bool missed = planner_alarm.kind == gps::AlarmKind::kMissed;
+    {
+      std::lock_guard lock(health_mutex_);
+      if (missed) {
+        ++missed_;
+        ++rows_[rowOf(planner_alarm.location_id)].missed;
+        missed_locations_.push_back(planner_alarm.location_id);
+      } else {
+        ++too_fast_;
+      }
+    }
+    alarm(missed ? "missed" : "too_fast", planner_alarm.message, planner_alarm.location_id);
+  }
+
+  void onFix(const core::GpsFix& fix) {
+    std::lock_guard lock(health_mutex_);
+    ++fixes_;
+    last_fix_ = fix;
+    if (fix.valid)
+      last_valid_fix_at_ = Clock::now();
+  }
+
+  void onSerial(const gps::SerialStatus& status) {
+    {
+      std::lock_guard lock(health_mutex_);
+      serial_state_ = std::string(gps::toString(status.event));
+    }
+    if (status.event == gps::SerialEvent::kLost)
+      alarm("serial_lost", status.device + ": " + status.message, "");
+    else if (status.event == gps::SerialEvent::kOpened)
+      spdlog::info("serial {} opened", status.device);
+  }
+
+  // Every kHousekeepingPeriod on the GPS thread: GPS loss and recovery, service status.
+  void housekeeping() {
+    std::optional<double> age;
+    bool lost_now = false, recovered = false;
+    {
+      std::lock_guard lock(health_mutex_);
+      if (last_valid_fix_at_)
+        age = std::chrono::duration<double>(Clock::now() - *last_valid_fix_at_).count();
+      const bool lost = !age || *age > kGpsLostAfterS;
+      if (lost && !gps_lost_ && (age || Clock::now() - started_at_ > std::chrono::seconds{5})) {
+        gps_lost_ = true;
+        lost_now = true;
+      } else if (!lost && gps_lost_) {
+        gps_lost_ = false;
+        recovered = true;
+      }
+    }
+    if (lost_now) {
+      alarm("gps_lost",
+            age ? "no valid fix for " + std::to_string(*age).substr(0, 4) +
+                      " s: no triggers until fixes return; locations passed meanwhile are missed"
+                : "no valid fix yet: check the receiver's cable and its RTK status",
+            "");
+    }
+    if (recovered)
+      alarm("gps_recovered", "valid fixes again: triggering resumes", "");
+    if (!recording_stopped_alarmed_ && acquisition_->stats().recording_stopped) {
+      recording_stopped_alarmed_ = true;
+      alarm("recording_stopped", acquisition_->stats().alarm, "");
+    }
+    if (Clock::now() - last_status_notify_ > std::chrono::seconds{1}) {
+      last_status_notify_ = Clock::now();
+      const AcquisitionStats stats = acquisition_->stats();
+      notifier_.status("triggers " + std::to_string(acquisition_->triggered()) + ", recorded " +
+                       std::to_string(stats.sets_recorded) + ", processed " +
+                       std::to_string(stats.sets_processed) + (gps_lost_ ? ", GPS LOST" : ""));
+    }
+  }
+
+  // Virtual time: the planner in GPS time, every trigger once the pipeline has room.
+  void runVirtualTime(const fs::path& nmea_path) {
+    boost::asio::io_context control;
+    boost::asio::signal_set signals(control, SIGINT, SIGTERM, SIGHUP);
+    watchSignals(signals, [] {});
+    notifier_.startWatchdog(control);
+    std::thread control_thread([&control] { control.run(); });
+    notifier_.ready();
+
+    std::ifstream nmea(nmea_path, std::ios::binary);
+    // Processing takes as many sets as its queue holds; without processing, half the pool.
+    const std::uint64_t room = processor_
+                                   ? std::max<std::size_t>(1, config_.pipeline.queue_sets)
+                                   : std::max<std::size_t>(1, config_.cameras.rig.pool_sets / 2);
+    gps::ReplayHandlers handlers;
+    handlers.on_trigger = [&](const core::TriggerEvent& event) {
+      if (stop_requested_)
+        return;
+      while (!stop_requested_ && acquisition_->inFlight() >= room &&
+             !acquisition_->stats().recording_stopped) {
+        std::this_thread::sleep_for(std::chrono::microseconds{500});
+      }
+      if (event.fix)
+        onFix(*event.fix);
+      onTrigger(event);
+    };
+    handlers.on_alarm = [this](const gps::PlannerAlarm& a) { onPlannerAlarm(a); };
+    const gps::ReplaySummary summary =
+        gps::replayTriggers(nmea, map_, config_.gps.triggers, handlers);
+    nmea_stats_ = summary.nmea;
+    planner_stats_ = summary.planner;
+    control.stop();
+    control_thread.join();
+  }
+
+  // Real time: the serial path of the field, from a device, or from a file played into a pty.
+  void runLive(const fs::path& nmea_path, bool play_file) {
+    boost::asio::io_context io;
+    std::unique_ptr<NmeaPlayer> player;
+    std::string device = nmea_path.string();
+    if (play_file) {
+      auto started = NmeaPlayer::start(nmea_path, [&io, this] {
+        // The file is over: give the last triggers their frames, then end the run.
+        boost::asio::post(io, [this] { stop_requested_ = true; });
+      });
+      if (!started) {
+        spdlog::error("{}", started.error().message);
+        stop_requested_ = true;
+        return;
+      }
+      player = std::move(*started);
+      device = player->devicePath();
+    }
+    gps::LiveTriggerChain chain(
+        io, map_, config_.gps.triggers,
+        [this](const core::TriggerEvent& event, core::SteadyTime) { onTrigger(event); },
+        [this](const gps::PlannerAlarm& a) { onPlannerAlarm(a); },
+        [this](const core::GpsFix& fix) { onFix(fix); });
+    gps::SerialOptions serial = config_.gps.serial;
+    serial.device = device;
+    std::unique_ptr<gps::SerialNmeaSource> source;
+    try {
+      source = std::make_unique<gps::SerialNmeaSource>(
+          io, serial,
+          [&chain](const gps::Sentence& sentence, const core::ReceptionStamp& received) {
+            chain.onSentence(sentence, received);
+          },
+          [this](const gps::SerialStatus& status) { onSerial(status); });
+    } catch (const std::invalid_argument& error) {
+      spdlog::error("{}: gps.serial: {}", sourceName(), error.what());
+      return;
+    }
+    boost::asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
+    auto stop_all = [&] {
+      source->stop();
+      chain.stop();
+      io.stop();
+    };
+    watchSignals(signals, stop_all);
+    boost::asio::steady_timer housekeeping_timer(io);
+    std::function<void()> arm = [&] {
+      housekeeping_timer.expires_after(kHousekeepingPeriod);
+      housekeeping_timer.async_wait([&](const boost::system::error_code& error) {
+        if (error)
+          return;
+        housekeeping();
+        if (stop_requested_) {
+          stop_all();
+          return;
+        }
+        arm();
+      });
+    };
+    arm();
+    notifier_.startWatchdog(io);
+    source->start();
+    notifier_.ready();
+    io.run();
+    nmea_stats_ = source->stats();
+    planner_stats_ = chain.planner().stats();
+  }
+
+  void watchSignals(boost::asio::signal_set& signals, std::function<void()> on_stop) {
+    signals.async_wait(
+        [this, &signals, on_stop](const boost::system::error_code& error, int number) {
+          if (error)
+            return;
+          if (number == SIGHUP) {
+            core::setupLogging(config_.log.level, config_.log.file.string());
+            spdlog::info("SIGHUP: log reopened");
+            watchSignals(signals, on_stop);
+            return;
+          }
+          spdlog::info("signal {}: finishing the set in flight, then closing the session", number);
+          notifier_.stopping();
+          stop_requested_ = true;
+          on_stop();
+        });
+  }
+
+  // ---- processing thread ----------------------------------------------------------------------
+
+  void processSet(const core::FrameSet& set) {
+    std::vector<std::string> problems;
+    const auto heads =
+        headFramesFromFrameSet(set, acquisition_->cameraNames(), processor_->rig(), problems);
+    const pipeline::PlotResult result = processor_->process(heads, std::move(problems));
+    const core::TriggerEvent& event = set.trigger;
+    PlotIdentity identity;
+    identity.trigger_id = set.trigger_id;
+    if (!event.location_id.empty())
+      identity.location_id = event.location_id;
+    identity.time =
+        core::formatIso8601(event.location_id.empty() ? event.sent_time : event.time, 6);
+    identity.position = plotPosition(identity.location_id, event.fix, &map_);
+    identity.trigger_status =
+        event.location_id.empty() ? std::string() : std::string(core::toString(event.status));
+    const Json line = plotLine(identity, result);
+    if (const std::string failed = results_->add(line); !failed.empty())
+      alarm("results_not_written", failed, event.location_id);
+    if (options_.print_results)
+      std::cout << line.dump() << std::endl;
+    const double latency_ms = event.sent_time == core::UtcTime{}
+                                  ? 0
+                                  : std::chrono::duration<double, std::milli>(
+                                        std::chrono::system_clock::now() - event.sent_time)
+                                        .count();
+    std::lock_guard lock(health_mutex_);
+    latencies_ms_.push_back(latency_ms);
+    last_latency_ms_ = latency_ms;
+    max_latency_ms_ = std::max(max_latency_ms_, latency_ms);
+    last_plot_ = Json{{"plot", line.at("plot")},
+                      {"status", line.at("traits").at("status")},
+                      {"height_m", line.at("traits").at("height_m")},
+                      {"width_m", line.at("traits").at("width_m")},
+                      {"vvi", line.at("traits").at("vvi")},
+                      {"vai", line.at("traits").at("vai")},
+                      {"partial", result.partial},
+                      {"problems", line.at("problems")}};
+  }
+
+  // ---- any thread -----------------------------------------------------------------------------
+
+  void alarm(const std::string& kind, const std::string& message, const std::string& location) {
+    spdlog::warn("alarm {}{}: {}", kind, location.empty() ? "" : " at " + location, message);
+    std::lock_guard lock(health_mutex_);
+    ++alarms_total_;
+    alarms_.push_back(Json{{"time", nowIso()},
+                           {"kind", kind},
+                           {"location", location.empty() ? Json(nullptr) : Json(location)},
+                           {"message", message}});
+    if (alarms_.size() > kAlarmsKept)
+      alarms_.pop_front();
+  }
+
+  std::string rowOf(const std::string& location_id) const {
+    const auto it = location_rows_.find(location_id);
+    return it == location_rows_.end() ? "unknown" : it->second;
+  }
+
+  Json snapshot() const {
+    if (!acquisition_ready_)
+      return Json{{"mode", options_.mode == Mode::kRun ? "run" : "replay"}, {"starting", true}};
+    const AcquisitionStats stats = acquisition_->stats();
+    const std::uint64_t triggered = acquisition_->triggered();
+    Json out;
+    out["mode"] = options_.mode == Mode::kRun ? "run" : "replay";
+    out["time"] = nowIso();
+    out["uptime_s"] = std::chrono::duration<double>(Clock::now() - started_at_).count();
+    out["session"] = config_.recording.dir.string();
+    std::lock_guard lock(health_mutex_);
+    Json gps_status;
+    gps_status["serial"] = serial_state_;
+    gps_status["lost"] = gps_lost_;
+    gps_status["fixes"] = fixes_;
+    gps_status["fix_age_s"] =
+        last_valid_fix_at_
+            ? Json(std::chrono::duration<double>(Clock::now() - *last_valid_fix_at_).count())
+            : Json(nullptr);
+    if (last_fix_) {
+      gps_status["valid"] = last_fix_->valid;
+      gps_status["quality"] =
+          last_fix_->quality ? Json(static_cast<int>(*last_fix_->quality)) : Json(nullptr);
+      gps_status["satellites"] =
+          last_fix_->satellites ? Json(*last_fix_->satellites) : Json(nullptr);
+      gps_status["hdop"] = last_fix_->hdop ? Json(*last_fix_->hdop) : Json(nullptr);
+      gps_status["lat"] = last_fix_->latitude_deg;
+      gps_status["lon"] = last_fix_->longitude_deg;
+      gps_status["course_deg"] =
+          last_fix_->course_deg ? Json(*last_fix_->course_deg) : Json(nullptr);
+    }
+    out["gps"] = gps_status;
+    const double speed = last_fix_ && last_fix_->speed_mps ? *last_fix_->speed_mps : 0.0;
+    const double ratio = max_speed_mps_ > 0 ? speed / max_speed_mps_ : 0.0;
+    out["speed"] = {{"speed_mps", speed},
+                    {"max_speed_mps", max_speed_mps_},
+                    {"ratio", ratio},
+                    {"level", ratio >= 1.0               ? "over"
+                              : ratio >= kSpeedWarnRatio ? "warn"
+                                                         : "ok"}};
+    Json rows = Json::object();
+    for (const auto& [name, row] : rows_) {
+      rows[name] = {{"locations", row.locations},
+                    {"fired", row.fired},
+                    {"late", row.late},
+                    {"missed", row.missed}};
+    }
+    out["triggers"] = {{"fired", triggers_},  {"late", late_},
+                       {"missed", missed_},   {"too_fast", too_fast_},
+                       {"refused", refused_}, {"locations", map_.size()},
+                       {"rows", rows},        {"missed_locations", missed_locations_}};
+    if (last_trigger_) {
+      out["triggers"]["last"] = {{"location", last_trigger_->location_id},
+                                 {"time", core::formatIso8601(last_trigger_->time, 3)},
+                                 {"status", core::toString(last_trigger_->status)}};
+    }
+    out["queues"] = {{"in_flight", acquisition_->inFlight()},
+                     {"to_record", triggered > stats.sets_recorded + stats.sets_lost
+                                       ? triggered - stats.sets_recorded - stats.sets_lost
+                                       : 0}};
+    out["sets"] = {{"triggered", triggered},
+                   {"recorded", stats.sets_recorded},
+                   {"incomplete", stats.rig.incomplete_sets},
+                   {"lost", stats.sets_lost},
+                   {"skipped_for_processing", stats.sets_skipped_for_processing},
+                   {"processed", stats.sets_processed},
+                   {"frames_missing", stats.rig.frames_missing},
+                   {"frames_dropped", stats.rig.frames_dropped},
+                   {"frames_corrupt", stats.rig.frames_corrupt},
+                   {"recording_stopped", stats.recording_stopped}};
+    out["processing"] = {{"enabled", processor_.has_value()},
+                         {"last_latency_ms", last_latency_ms_},
+                         {"max_latency_ms", max_latency_ms_},
+                         {"last_plot", last_plot_}};
+    Json disk;
+    struct statvfs fs_info {};
+    if (::statvfs(config_.recording.dir.c_str(), &fs_info) == 0) {
+      const double free_bytes = static_cast<double>(fs_info.f_bavail) * fs_info.f_frsize;
+      const double elapsed_h =
+          std::chrono::duration<double>(Clock::now() - started_at_).count() / 3600.0;
+      const double rate = elapsed_h > 0 ? static_cast<double>(stats.bytes_written) / elapsed_h : 0;
+      disk["free_bytes"] = free_bytes;
+      disk["bytes_written"] = stats.bytes_written;
+      disk["bytes_per_hour"] = rate;
+      disk["hours_left"] = rate > 0 ? Json(free_bytes / rate) : Json(nullptr);
+    }
+    out["disk"] = disk;
+    const auto [rss_mb, peak_rss_mb] = memoryMb();
+    out["memory"] = {{"rss_mb", rss_mb}, {"peak_rss_mb", peak_rss_mb}};
+    out["alarms_total"] = alarms_total_;
+    out["alarms"] = Json(alarms_);
+    return out;
+  }
+
+  int finish() {
+    notifier_.stopping();
+    acquisition_->finish(kFinishTimeout);
+    if (results_) {
+      if (const std::string failed = results_->flush(); !failed.empty())
+        alarm("results_not_written", failed, "");
+    }
+    status_.reset();
+    const AcquisitionStats stats = acquisition_->stats();
+    Json summary;
+    summary["locations"] = map_.size();
+    summary["fixes"] = planner_stats_.fixes;
+    summary["triggers"] = acquisition_->triggered();
+    summary["triggers_late"] = late_;
+    summary["missed"] = missed_;
+    summary["sets_recorded"] = stats.sets_recorded;
+    summary["sets_incomplete"] = stats.rig.incomplete_sets;
+    summary["sets_lost"] = stats.sets_lost;
+    summary["sets_processed"] = stats.sets_processed;
+    summary["sets_skipped_for_processing"] = stats.sets_skipped_for_processing;
+    summary["recording_stopped"] = stats.recording_stopped;
+    summary["alarms"] = alarms_total_;
+    // How the run went on this machine (not results: they vary from run to run).
+    const double elapsed_s = std::chrono::duration<double>(Clock::now() - started_at_).count();
+    summary["elapsed_s"] = elapsed_s;
+    summary["sets_per_s"] =
+        elapsed_s > 0 ? static_cast<double>(stats.sets_processed) / elapsed_s : 0;
+    std::vector<double> latencies = latencies_ms_;
+    std::sort(latencies.begin(), latencies.end());
+    if (!latencies.empty()) {
+      double sum = 0;
+      for (double l : latencies)
+        sum += l;
+      summary["latency_ms"] = {
+          {"mean", sum / static_cast<double>(latencies.size())},
+          {"p95", latencies[std::min(latencies.size() - 1, latencies.size() * 95 / 100)]},
+          {"max", latencies.back()}};
+    }
+    summary["peak_rss_mb"] = memoryMb().second;
+    summary["session"] = config_.recording.dir.string();
+    if (results_)
+      summary["results"] = results_->dir().string();
+    if (options_.print_results)
+      std::cout << Json{{"summary", summary}}.dump() << std::endl;
+    if (stats.sets_skipped_for_processing > 0) {
+      spdlog::warn(
+          "{} sets were recorded but not processed live: `fieldrig process {}` completes "
+          "the results (it skips the plots already there)",
+          stats.sets_skipped_for_processing, config_.recording.dir.string());
+    }
+    spdlog::info("fieldrigd: session {} closed", config_.recording.dir.string());
+    if (stats.recording_stopped) {
+      spdlog::error("recording stopped: {}", stats.alarm);
+      return kExitRuntime;
+    }
+    return kExitOk;
+  }
+
+  const DaemonOptions& options_;
+  const config::Config& config_;
+  gps::LocationMap map_;
+  std::map<std::string, std::string> location_rows_;
+  double max_speed_mps_ = 0;
+  std::optional<pipeline::PlotProcessor> processor_;  // the processing thread's
+  std::unique_ptr<ResultsWriter> results_;            // the processing thread's, then finish()'s
+  std::unique_ptr<Acquisition> acquisition_;
+  std::atomic<bool> acquisition_ready_{false};  // acquisition_ is set: the status may read it
+  std::unique_ptr<StatusServer> status_;
+  ServiceNotifier notifier_;
+  std::atomic<bool> stop_requested_{false};
+  Clock::time_point started_at_ = Clock::now();
+  Clock::time_point last_status_notify_{};
+  gps::NmeaStats nmea_stats_;
+  gps::TriggerStats planner_stats_;
+
+  // Health: written by the GPS and processing threads, read by the status thread.
+  mutable std::mutex health_mutex_;
+  std::map<std::string, RowCounts> rows_;
+  std::uint64_t triggers_ = 0, late_ = 0, missed_ = 0, too_fast_ = 0, refused_ = 0, fixes_ = 0;
+  std::vector<std::string> missed_locations_;
+  std::optional<core::GpsFix> last_fix_;
+  std::optional<Clock::time_point> last_valid_fix_at_;
+  std::optional<core::TriggerEvent> last_trigger_;
+  bool gps_lost_ = false;
+  std::atomic<bool> recording_stopped_alarmed_{false};
+  std::string serial_state_ = "not opened";
+  double last_latency_ms_ = 0, max_latency_ms_ = 0;
+  std::vector<double> latencies_ms_;  // trigger sent → plot written, per processed set
+  Json last_plot_ = nullptr;
+  std::deque<Json> alarms_;
+  std::uint64_t alarms_total_ = 0;
+};
+
+}  // namespace
+
+int runDaemon(const DaemonOptions& options) {
+  Daemon daemon(options);
+  return daemon.run();
+}
+
+}  // namespace fieldrig::daemon

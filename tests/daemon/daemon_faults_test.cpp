@@ -1,0 +1,246 @@
+// Faults fieldrigd must survive, each through the real daemon process on a replay of the
+// synthetic field (daemon_field fixture): bad configuration, map or calibration at start (a clear
+// error, nothing written), a camera dropping frames (sets recorded and flagged, the run goes on),
+// SIGTERM mid-run (the set in flight finished, the session closed whole), kill -9 and a restart
+// (the session verifies and the daemon carries on into it), a full disk (recording stops cleanly
+// with an alarm, what was written stays readable), and the status served while it runs.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+
+#include "fieldrig/recording/session_reader.h"
+#include "support/cli_process.h"
+#include "support/cli_run.h"
+#include "support/daemon_run.h"
+#include "support/temp_dir.h"
+#include "support/tmpfs_mount.h"
+
+namespace fieldrig {
+namespace {
+
+using namespace std::chrono_literals;
+using testing_support::FieldrigProcess;
+using testing_support::readWholeFile;
+using testing_support::runDaemon;
+using testing_support::runFieldrig;
+using testing_support::ScopedTempDir;
+using testing_support::writeReplayConfig;
+using Json = nlohmann::json;
+namespace fs = std::filesystem;
+
+std::size_t plotLines(const std::vector<std::string>& lines) {
+  std::size_t plots = 0;
+  for (const std::string& line : lines)
+    plots += line.find("\"traits\"") != std::string::npos ? 1 : 0;
+  return plots;
+}
+
+Json summaryOf(const std::vector<std::string>& lines) {
+  for (const std::string& line : lines) {
+    if (line.rfind("{\"summary\"", 0) == 0)
+      return Json::parse(line).at("summary");
+  }
+  return nullptr;
+}
+
+class DaemonFaults : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    field_ = testing_support::daemonField();
+    ASSERT_TRUE(fs::exists(field_ / "map.csv")) << "the daemon_field fixture did not run";
+  }
+  fs::path field_;
+};
+
+TEST_F(DaemonFaults, AnUnknownConfigKeyIsNamedWithItsLineAndNothingIsWritten) {
+  ScopedTempDir dir("daemon_bad_key");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_, "",
+                                            "pipeline:\n  queue_sets: 2\n  quue_sets: 3\n");
+  const auto run = runDaemon({"replay", "--config", config.string()}, dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("run.yaml:"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("pipeline.quue_sets"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a bad configuration wrote something";
+  const auto check = runDaemon({"--check-config", config.string()}, dir.path());
+  EXPECT_EQ(check.exit_code, 2);
+  EXPECT_NE(check.err.find("pipeline.quue_sets"), std::string::npos) << check.err;
+}
+
+TEST_F(DaemonFaults, ABadMapLineIsNamedAndNothingIsWritten) {
+  ScopedTempDir dir("daemon_bad_map");
+  std::string map = readWholeFile(field_ / "map.csv");
+  map += "R09P09,not-a-latitude,-93.7,0,9,9,9\n";
+  const fs::path bad_map = dir.path() / "bad_map.csv";
+  std::ofstream(bad_map) << map;
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_, "", "");
+  std::string text = readWholeFile(config);
+  text = std::regex_replace(text, std::regex("map: .*\n"), "map: " + bad_map.string() + "\n");
+  std::ofstream(config) << text;
+  const auto run = runDaemon({"replay", "--config", config.string()}, dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("bad_map.csv:"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a bad map wrote something";
+}
+
+TEST_F(DaemonFaults, AMissingCalibrationIsNamedAndNothingIsWritten) {
+  ScopedTempDir dir("daemon_bad_calib");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  std::string text = readWholeFile(config);
+  text = std::regex_replace(text, std::regex("calibration: .*\n"),
+                            "calibration: " + (dir.path() / "no-such-calib").string() + "\n");
+  std::ofstream(config) << text;
+  const auto run = runDaemon({"replay", "--config", config.string()}, dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("no-such-calib"), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a bad calibration wrote something";
+}
+
+TEST_F(DaemonFaults, ACameraDroppingFramesGivesFlaggedIncompleteSetsAndTheRunGoesOn) {
+  ScopedTempDir dir("daemon_drops");
+  // Every camera loses the frames of every fourth trigger: those sets arrive empty.
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_, "drop_every: 4");
+  const auto run = runDaemon({"replay", "--config", config.string()}, dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Json summary = summaryOf(run.out_lines);
+  ASSERT_FALSE(summary.is_null()) << run.err;
+  EXPECT_EQ(summary.at("sets_recorded"), summary.at("triggers"));
+  EXPECT_EQ(summary.at("sets_incomplete"), summary.at("triggers").get<int>() / 4);
+  EXPECT_EQ(summary.at("sets_processed"), summary.at("triggers"));
+  int flagged = 0;
+  for (const std::string& text : run.out_lines) {
+    if (text.find("\"traits\"") == std::string::npos)
+      continue;
+    const Json line = Json::parse(text);
+    if (line.at("trigger_id").get<int>() % 4 == 0) {
+      ++flagged;
+      EXPECT_NE(line.at("traits").at("status"), "ok") << text;
+      EXPECT_NE(line.at("problems").dump().find("missing"), std::string::npos) << text;
+    } else {
+      EXPECT_EQ(line.at("traits").at("status"), "ok") << text;
+    }
+  }
+  EXPECT_EQ(flagged, summary.at("triggers").get<int>() / 4);
+  const auto reader = recording::SessionReader::open(dir.path() / "run" / "session");
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  int incomplete = 0;
+  for (const recording::IndexedSet& set : reader->sets())
+    incomplete += set.complete ? 0 : 1;
+  EXPECT_EQ(incomplete, summary.at("sets_incomplete").get<int>());
+}
+
+TEST_F(DaemonFaults, SigtermMidRunFinishesTheSetInFlightAndClosesTheSession) {
+  ScopedTempDir dir("daemon_sigterm");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  FieldrigProcess daemon({"replay", "--config", config.string()}, dir.path(),
+                         testing_support::kFieldrigdBinary);
+  ASSERT_TRUE(daemon.waitForStdoutLines(3, 60s)) << daemon.err();
+  ASSERT_TRUE(daemon.signal(SIGTERM));
+  ASSERT_EQ(daemon.waitExit(30s), 0) << daemon.err();
+  const auto lines = daemon.outLines();
+  const Json summary = summaryOf(lines);
+  ASSERT_FALSE(summary.is_null()) << daemon.out();
+  EXPECT_LT(summary.at("triggers").get<int>(), 12) << "the signal did not stop the replay";
+  // Every triggered set recorded and processed: none was abandoned in flight.
+  EXPECT_EQ(summary.at("sets_recorded"), summary.at("triggers"));
+  EXPECT_EQ(summary.at("sets_processed"), summary.at("triggers"));
+  EXPECT_EQ(plotLines(lines), summary.at("sets_processed").get<std::size_t>());
+  const auto verify = runFieldrig(
+      {"session", "info", (dir.path() / "run" / "session").string(), "--verify"}, dir.path());
+  EXPECT_EQ(verify.exit_code, 0) << verify.err;
+}
+
+TEST_F(DaemonFaults, KillNineThenRestartVerifiesAndCarriesOnIntoTheSession) {
+  ScopedTempDir dir("daemon_kill9");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  const fs::path session = dir.path() / "run" / "session";
+  std::size_t first_run_plots = 0;
+  {
+    FieldrigProcess daemon({"replay", "--config", config.string()}, dir.path(),
+                           testing_support::kFieldrigdBinary);
+    ASSERT_TRUE(daemon.waitForStdoutLines(4, 60s)) << daemon.err();
+    ASSERT_TRUE(daemon.signal(SIGKILL));
+    daemon.waitExit(10s);
+    first_run_plots = plotLines(daemon.outLines());
+  }
+  const auto verify = runFieldrig({"session", "info", session.string(), "--verify"}, dir.path());
+  ASSERT_EQ(verify.exit_code, 0) << verify.err;
+  const auto before = recording::SessionReader::open(session);
+  ASSERT_TRUE(before.ok()) << before.error().message;
+  const std::size_t recorded_before = before->sets().size();
+  EXPECT_GE(recorded_before, first_run_plots);
+
+  const auto restart = runDaemon({"replay", "--config", config.string()}, dir.path());
+  ASSERT_EQ(restart.exit_code, 0) << restart.err;
+  const Json summary = summaryOf(restart.out_lines);
+  ASSERT_FALSE(summary.is_null()) << restart.err;
+  const auto after = recording::SessionReader::open(session);
+  ASSERT_TRUE(after.ok()) << after.error().message;
+  EXPECT_EQ(after->sets().size(), recorded_before + summary.at("sets_recorded").get<std::size_t>());
+  std::set<std::uint64_t> trigger_ids;
+  for (const recording::IndexedSet& set : after->sets())
+    EXPECT_TRUE(trigger_ids.insert(set.trigger_id).second) << "trigger id reused after restart";
+  const auto verify_after =
+      runFieldrig({"session", "info", session.string(), "--verify"}, dir.path());
+  EXPECT_EQ(verify_after.exit_code, 0) << verify_after.err;
+  // The results folder carries both runs: every line whole.
+  std::ifstream results(session / "results" / "plots.jsonl");
+  std::size_t lines = 0;
+  for (std::string line; std::getline(results, line); ++lines)
+    EXPECT_TRUE(Json::accept(line)) << line;
+  EXPECT_GE(lines, first_run_plots + summary.at("sets_processed").get<std::size_t>());
+}
+
+TEST_F(DaemonFaults, AFullDiskStopsRecordingWithAnAlarmAndKeepsWhatWasWritten) {
+  ScopedTempDir dir("daemon_disk_full");
+  // Six 1624×1224 frames are 12 MB a set: 40 MB hold three sets and the session's files.
+  testing_support::TmpfsMount tmpfs(dir.path() / "small", "40m");
+  if (!tmpfs.mounted())
+    GTEST_SKIP() << "cannot mount a tmpfs here (" << tmpfs.error() << "): needs CAP_SYS_ADMIN";
+  const fs::path config = writeReplayConfig(dir.path() / "small", "run", field_);
+  const auto run = runDaemon({"replay", "--config", config.string()}, dir.path());
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find("recording_stopped"), std::string::npos) << run.err;
+  const Json summary = summaryOf(run.out_lines);
+  ASSERT_FALSE(summary.is_null()) << run.err;
+  EXPECT_TRUE(summary.at("recording_stopped").get<bool>());
+  EXPECT_GT(summary.at("sets_recorded").get<int>(), 0);
+  EXPECT_LT(summary.at("sets_recorded").get<int>(), 12);
+  const auto verify = runFieldrig(
+      {"session", "info", (dir.path() / "small" / "run" / "session").string(), "--verify"},
+      dir.path());
+  EXPECT_EQ(verify.exit_code, 0) << verify.err;
+}
+
+TEST_F(DaemonFaults, StatusIsServedAsJsonWhileItRuns) {
+  ScopedTempDir dir("daemon_status");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  FieldrigProcess daemon({"replay", "--config", config.string()}, dir.path(),
+                         testing_support::kFieldrigdBinary);
+  ASSERT_TRUE(daemon.waitForStderr("status_url", 30s)) << daemon.err();
+  const int port = testing_support::statusPort(daemon.err());
+  ASSERT_GT(port, 0) << daemon.err();
+  ASSERT_TRUE(daemon.waitForStdoutLines(1, 60s)) << daemon.err();
+  const std::string body = testing_support::httpGet(port, "/status");
+  ASSERT_FALSE(body.empty());
+  const Json status = Json::parse(body);
+  EXPECT_EQ(status.at("mode"), "replay");
+  EXPECT_GE(status.at("triggers").at("fired").get<int>(), 1);
+  EXPECT_EQ(status.at("triggers").at("locations"), 12);
+  EXPECT_TRUE(status.at("triggers").at("rows").contains("1"));
+  EXPECT_GT(status.at("speed").at("max_speed_mps").get<double>(), 0.0);
+  EXPECT_TRUE(status.at("disk").contains("free_bytes"));
+  EXPECT_EQ(testing_support::httpGet(port, "/healthz"), "ok\n");
+  ASSERT_EQ(daemon.waitExit(120s), 0) << daemon.err();
+}
+
+}  // namespace
+}  // namespace fieldrig

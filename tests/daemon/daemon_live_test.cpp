@@ -1,0 +1,182 @@
+// fieldrigd on the live serial path, through a real pseudo-terminal (socat) standing in for the
+// receiver: the synthetic field's drive is fed in real time with the faults of a field day. The
+// GPS goes silent mid-row, then sends invalid fixes (no triggers; a gps_lost alarm within about a
+// second; the location passed meanwhile reported missed; recovery when valid fixes return), and
+// the serial device is unplugged and replugged (serial_lost, then reopened and read again).
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+
+#include "support/cli_process.h"
+#include "support/daemon_run.h"
+#include "support/socat_pty.h"
+#include "support/temp_dir.h"
+
+namespace fieldrig {
+namespace {
+
+using namespace std::chrono_literals;
+using testing_support::FieldrigProcess;
+using testing_support::ScopedTempDir;
+using Json = nlohmann::json;
+namespace fs = std::filesystem;
+
+// One 10 Hz epoch of the drive: its seconds since the drive's start and its sentences.
+struct Epoch {
+  double t = 0;
+  std::vector<std::string> lines;
+};
+
+std::vector<Epoch> readEpochs(const fs::path& nmea) {
+  std::vector<Epoch> epochs;
+  std::ifstream in(nmea);
+  std::optional<double> first;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r')
+      line.pop_back();
+    if (line.size() < 17 || line.compare(3, 3, "RMC") != 0) {
+      if (!epochs.empty())
+        epochs.back().lines.push_back(line);
+      continue;
+    }
+    // $GNRMC,hhmmss.ss,…
+    const double hh = std::stod(line.substr(7, 2)), mm = std::stod(line.substr(9, 2)),
+                 ss = std::stod(line.substr(11, 5));
+    const double seconds = hh * 3600 + mm * 60 + ss;
+    if (!first)
+      first = seconds;
+    epochs.push_back({seconds - *first, {line}});
+  }
+  return epochs;
+}
+
+// The sentence with its fix made invalid (RMC status V, GGA quality 0) and its checksum redone.
+std::string invalidated(const std::string& line) {
+  std::vector<std::string> fields;
+  const std::string body = line.substr(1, line.find('*') - 1);
+  std::stringstream split(body);
+  for (std::string field; std::getline(split, field, ',');)
+    fields.push_back(field);
+  if (body.compare(2, 3, "RMC") == 0 && fields.size() > 2)
+    fields[2] = "V";
+  if (body.compare(2, 3, "GGA") == 0 && fields.size() > 6)
+    fields[6] = "0";
+  std::string joined;
+  for (std::size_t i = 0; i < fields.size(); ++i)
+    joined += (i ? "," : "") + fields[i];
+  unsigned checksum = 0;
+  for (char c : joined)
+    checksum ^= static_cast<unsigned char>(c);
+  char tail[8];
+  std::snprintf(tail, sizeof tail, "*%02X", checksum);
+  return "$" + joined + tail;
+}
+
+TEST(DaemonLive, GpsLossAndSerialUnplugAreAlarmedSurvivedAndRecovered) {
+  const fs::path field = testing_support::daemonField();
+  ASSERT_TRUE(fs::exists(field / "drive.nmea")) << "the daemon_field fixture did not run";
+  if (!testing_support::findSocat())
+    GTEST_SKIP() << "socat is not installed";
+  ScopedTempDir dir("daemon_live");
+  testing_support::SocatPty pty(dir.path() / "pty");
+  fs::create_directories(dir.path() / "pty");
+  ASSERT_EQ(pty.start(), "");
+  const fs::path config = testing_support::writeReplayConfig(
+      dir.path(), "run", field, "",
+      "gps:\n  serial:\n    reopen_initial_ms: 100\n    reopen_max_ms: 400\n");
+  FieldrigProcess daemon({"replay", "--config", config.string(), "--nmea", pty.device().string()},
+                         dir.path(), testing_support::kFieldrigdBinary);
+  ASSERT_TRUE(daemon.waitForStderr("status_url", 30s)) << daemon.err();
+  const int port = testing_support::statusPort(daemon.err());
+  ASSERT_GT(port, 0) << daemon.err();
+  auto status = [&] { return Json::parse(testing_support::httpGet(port, "/status")); };
+
+  const std::vector<Epoch> epochs = readEpochs(field / "drive.nmea");
+  ASSERT_GT(epochs.size(), 170U);
+  auto feed = std::make_unique<testing_support::Feed>(pty.feed());
+  ASSERT_TRUE(feed->ok());
+  const auto start = std::chrono::steady_clock::now();
+  auto at = [&](double t) { return start + std::chrono::microseconds(static_cast<long>(t * 1e6)); };
+  // Row 1's plots cross at 3.25, 5.25, 7.25, 9.25, 11.25 and 13.25 s of the drive.
+  constexpr double kSilenceFrom = 6.0, kInvalidFrom = 7.5, kValidFrom = 8.5;
+  constexpr double kUnplugAt = 13.6, kReplugAt = 14.6, kEnd = 16.0;
+  bool saw_lost = false;
+  double lost_after_s = 0;
+  bool unplugged = false;
+  for (const Epoch& epoch : epochs) {
+    if (epoch.t >= kEnd)
+      break;
+    if (epoch.t >= kSilenceFrom && epoch.t < kInvalidFrom) {
+      // Silence: the alarm must come within about a second.
+      if (!saw_lost && std::chrono::steady_clock::now() > at(kSilenceFrom)) {
+        const Json s = status();
+        if (s.at("gps").at("lost").get<bool>()) {
+          saw_lost = true;
+          lost_after_s =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - at(kSilenceFrom))
+                  .count();
+        }
+      }
+      std::this_thread::sleep_until(at(epoch.t));
+      continue;
+    }
+    if (epoch.t >= kUnplugAt && epoch.t < kReplugAt) {
+      if (!unplugged) {
+        feed.reset();
+        pty.kill();  // the cable is pulled
+        unplugged = true;
+      }
+      std::this_thread::sleep_until(at(epoch.t));
+      continue;
+    }
+    if (unplugged && epoch.t >= kReplugAt && !feed) {
+      ASSERT_EQ(pty.start(), "");  // plugged in again: the same device name
+      feed = std::make_unique<testing_support::Feed>(pty.feed());
+      ASSERT_TRUE(feed->ok());
+    }
+    std::this_thread::sleep_until(at(epoch.t));
+    for (const std::string& line : epoch.lines) {
+      const std::string sent =
+          epoch.t >= kInvalidFrom && epoch.t < kValidFrom ? invalidated(line) : line;
+      ASSERT_TRUE(feed->write(sent + "\r\n"));
+    }
+  }
+  std::this_thread::sleep_for(1s);
+  const Json final_status = status();
+  EXPECT_TRUE(saw_lost) << "gps.lost never showed during " << kInvalidFrom - kSilenceFrom
+                        << " s of silence";
+  EXPECT_LT(lost_after_s, 1.5);
+  EXPECT_FALSE(final_status.at("gps").at("lost").get<bool>()) << final_status.dump();
+  EXPECT_EQ(final_status.at("gps").at("serial"), "opened") << final_status.dump();
+  ASSERT_TRUE(daemon.signal(SIGTERM));
+  ASSERT_EQ(daemon.waitExit(30s), 0) << daemon.err();
+
+  std::set<std::string> fired;
+  for (const std::string& text : daemon.outLines()) {
+    if (text.find("\"traits\"") != std::string::npos)
+      fired.insert(Json::parse(text).at("location").get<std::string>());
+  }
+  EXPECT_TRUE(fired.count("R01P01") && fired.count("R01P02")) << "before the loss";
+  EXPECT_FALSE(fired.count("R01P03")) << "fired without valid fixes";
+  EXPECT_TRUE(fired.count("R01P05") && fired.count("R01P06")) << "after the recovery";
+  const Json missed = final_status.at("triggers").at("missed_locations");
+  EXPECT_NE(std::find(missed.begin(), missed.end(), "R01P03"), missed.end()) << missed.dump();
+  const std::string log = daemon.err();
+  EXPECT_NE(log.find("alarm gps_lost"), std::string::npos) << log;
+  EXPECT_NE(log.find("alarm gps_recovered"), std::string::npos) << log;
+  EXPECT_NE(log.find("alarm missed at R01P03"), std::string::npos) << log;
+  EXPECT_NE(log.find("alarm serial_lost"), std::string::npos) << log;
+}
+
+}  // namespace
+}  // namespace fieldrig
