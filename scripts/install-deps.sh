@@ -9,7 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libssl-dev zlib1g-dev  # recording: SHA-256 of the location map (EVP), CRC-32 per frame
   libdc1394-dev  # the dc1394 driver (IEEE-1394 IIDC cameras); optional: skipped when absent
-  libyaml-cpp-dev  # dc1394 tests read ROS camera1394 parameter files
+  libyaml-cpp-dev  # the YAML configuration (config/); dc1394 tests read ROS camera1394 files
   socat          # serial tests run through real pseudo-terminals
   clang libclang-rt-14-dev  # libFuzzer for the NMEA parser fuzz test
   # The aravis driver and its tests (arv-fake-gv-camera-0.8); Debian's aravis-0.8.pc also
@@ -20,6 +20,11 @@ packages=(
   libopencv-dev libopencv-contrib-dev libpcl-dev libeigen3-dev mpi-default-dev
   # stem-ui's browser test drives Debian's headless Chromium (Playwright comes from npm).
   chromium
+  # fieldrigd: sd_notify (READY, STATUS, WATCHDOG) from libsystemd; the systemd tests run
+  # systemd-analyze verify on the unit and systemd-sysusers --dry-run (no systemd as PID 1 needed).
+  systemd libsystemd-dev
+  # The demo's traits-against-truth table and the whole-run daemon benchmark.
+  python3
 )
 
 missing=()

@@ -693,8 +693,7 @@ class Daemon {
     summary["session"] = config_.recording.dir.string();
     if (results_)
       summary["results"] = results_->dir().string();
-    if (options_.print_results)
-      std::cout << Json{{"summary", summary}}.dump() << std::endl;
+    std::cout << Json{{"summary", summary}}.dump() << std::endl;
     if (stats.sets_skipped_for_processing > 0) {
       spdlog::warn(
           "{} sets were recorded but not processed live: `fieldrig process {}` completes "

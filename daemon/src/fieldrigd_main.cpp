@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
     mode->add_option("--status-address", status_address,
                      "Status address (overrides status.address)");
     mode->add_flag("--no-status", no_status, "Serve no status");
-    mode->add_flag("--quiet", quiet, "No per-plot lines on stdout");
+    mode->add_flag("--quiet", quiet, "No per-plot lines on stdout (the summary line stays)");
   };
   CLI::App* run = app.add_subcommand("run", "The field run: serial NMEA, the configured cameras");
   add_common(run);

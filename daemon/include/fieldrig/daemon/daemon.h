@@ -31,7 +31,7 @@ enum class Mode { kRun, kReplay };
 struct DaemonOptions {
   config::Config config;
   Mode mode = Mode::kRun;
-  bool print_results = true;  // one JSON line per plot on stdout, then a summary line
+  bool print_results = true;  // one JSON line per plot on stdout (the summary line always)
 };
 
 // Exit codes: 0 done (signal or end of replay), 2 bad configuration or input at start (nothing
