@@ -194,6 +194,13 @@ std::optional<std::string> checkLocation(const ImagingLocation& location) {
   return std::nullopt;
 }
 
+// "'text' why". By append, not "'" + std::string: GCC 12 -O3 gives a false-positive -Wrestrict.
+std::string quotedText(std::string_view text, std::string_view why) {
+  std::string message(1, '\'');
+  message.append(text).append("' ").append(why);
+  return message;
+}
+
 // Parses a whole field as a finite double; the message says why not.
 std::optional<std::string> parseNumber(std::string_view text, double& out) {
   std::string_view digits = text;
@@ -201,10 +208,10 @@ std::optional<std::string> parseNumber(std::string_view text, double& out) {
     digits.remove_prefix(1);
   const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), out);
   if (digits.empty() || ec == std::errc::invalid_argument || ptr != digits.data() + digits.size()) {
-    return "'" + std::string(text) + "' is not a number";
+    return quotedText(text, "is not a number");
   }
   if (ec == std::errc::result_out_of_range || !std::isfinite(out)) {
-    return "'" + std::string(text) + "' is not a finite number";
+    return quotedText(text, "is not a finite number");
   }
   return std::nullopt;
 }

@@ -34,8 +34,9 @@ int main(int argc, char** argv) {
   testing_support::SyntheticRig rig(320, 240);
   for (std::uint64_t trigger = 1000 * (opened->next_set_index + 1);; ++trigger) {
     rig.fill(trigger);
+    // append, not "L" + std::string: GCC 12 -O3 gives a false-positive -Wrestrict.
     const recording::WriteOutcome outcome =
-        writer.write(rig.record(trigger, "L" + std::to_string(trigger % 7)));
+        writer.write(rig.record(trigger, std::string("L").append(std::to_string(trigger % 7))));
     if (!outcome.ok()) {
       std::fprintf(stderr, "%s\n", outcome.message.c_str());
       return 3;

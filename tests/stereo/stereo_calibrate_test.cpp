@@ -18,7 +18,8 @@ const std::string kCalibDir = std::string(FIELDRIG_SHARED_DATA_DIR) + "/stereo/o
 std::vector<PairCorners> samplePairs(const BoardSpec& board, cv::Size& size) {
   std::vector<PairCorners> pairs;
   for (int i : {1, 2, 3, 4, 5, 6, 7, 8, 9, 11, 12, 13, 14}) {
-    const std::string number = (i < 10 ? "0" : "") + std::to_string(i);
+    // append, not "0" + std::string: GCC 12 -O3 gives a false-positive -Wrestrict.
+    const std::string number = std::string(i < 10 ? "0" : "").append(std::to_string(i));
     PairCorners pair;
     pair.name = number;
     const cv::Mat left = cv::imread(kCalibDir + "left" + number + ".jpg", cv::IMREAD_GRAYSCALE);

@@ -95,13 +95,22 @@ std::string csvHeader() {
 }
 
 std::string toCsvRow(const MeasurementRecord& r) {
-  std::string row = quoted(r.session) + "," + std::to_string(r.set_index) + "," +
-                    std::to_string(r.trigger_id) + "," + quoted(r.head) + "," +
-                    quoted(r.stem_label);
-  for (const cv::Point2d& p : r.points)
-    row += "," + number(p.x, 2) + "," + number(p.y, 2);
-  row += "," + number(r.disparity_px, 3) + "," + number(r.ncc, 4) + "," + number(r.diameter_mm, 3) +
-         "," + quoted(r.time) + "," + std::to_string(r.repeat);
+  // append, not `"," + std::string`: GCC 12 -O3 gives a false-positive -Wrestrict on that insert.
+  std::string row = quoted(r.session);
+  const auto field = [&row](const std::string& text) { row.append(1, ',').append(text); };
+  field(std::to_string(r.set_index));
+  field(std::to_string(r.trigger_id));
+  field(quoted(r.head));
+  field(quoted(r.stem_label));
+  for (const cv::Point2d& p : r.points) {
+    field(number(p.x, 2));
+    field(number(p.y, 2));
+  }
+  field(number(r.disparity_px, 3));
+  field(number(r.ncc, 4));
+  field(number(r.diameter_mm, 3));
+  field(quoted(r.time));
+  field(std::to_string(r.repeat));
   return row;
 }
 
