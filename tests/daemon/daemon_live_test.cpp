@@ -178,5 +178,52 @@ TEST(DaemonLive, GpsLossAndSerialUnplugAreAlarmedSurvivedAndRecovered) {
   EXPECT_NE(log.find("alarm serial_lost"), std::string::npos) << log;
 }
 
+TEST(DaemonLive, ProcessingSlowerThanTheDriveLosesNothingAndFieldrigProcessCompletesIt) {
+  const fs::path field = testing_support::daemonField();
+  ASSERT_TRUE(fs::exists(field / "drive.nmea")) << "the daemon_field fixture did not run";
+  ScopedTempDir dir("daemon_slow");
+  // The paper's surface area (MLS + greedy triangulation, about 3.5 s a plot here) behind a
+  // one-set queue, with plots every 2 s in real time (the drive file played at its own pace
+  // through the daemon's pty): live processing must fall behind and skip.
+  const std::string slow_traits = "pipeline:\n  queue_sets: 1\n  traits:\n    area_method: paper\n";
+  const fs::path config = testing_support::writeReplayConfig(dir.path(), "run", field, "",
+                                                             slow_traits + "log:\n  level: info\n");
+  const auto run =
+      testing_support::runDaemon({"replay", "--config", config.string(), "--realtime"}, dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Json summary = Json::parse(run.out_lines.back()).at("summary");
+  // Which locations trigger is not this test's business: with both cores busy, the kernel has
+  // been seen to hold the pty's bytes back for 1-4 s (reported with issue 12), and a
+  // location passed meanwhile is missed. What is: every triggered set recorded, and each either
+  // processed or skipped and counted.
+  const int recorded = summary.at("sets_recorded").get<int>();
+  EXPECT_EQ(recorded, summary.at("triggers").get<int>());
+  EXPECT_GE(recorded, 6) << run.err;
+  const int processed = summary.at("sets_processed").get<int>();
+  const int skipped = summary.at("sets_skipped_for_processing").get<int>();
+  EXPECT_GT(skipped, 0) << "processing kept up: the test did not test the skip";
+  EXPECT_EQ(processed + skipped, recorded);
+  EXPECT_NE(run.err.find("fieldrig process"), std::string::npos) << "the log says how to finish";
+
+  // Offline, the same processor finishes what was skipped, into the same results.
+  const fs::path traits = dir.path() / "slow-traits.yaml";
+  std::ofstream(traits) << "area_method: paper\n";
+  const fs::path session = dir.path() / "run" / "session";
+  const auto completed =
+      testing_support::runFieldrig({"process", session.string(), "--traits-config", traits.string(),
+                                    "--map", (field / "map.csv").string()},
+                                   dir.path());
+  ASSERT_EQ(completed.exit_code, 0) << completed.err;
+  const Json offline = Json::parse(completed.out_lines.back()).at("summary");
+  EXPECT_EQ(offline.at("already_done"), processed);
+  EXPECT_EQ(offline.at("sets"), skipped);
+  EXPECT_EQ(offline.at("plots_in_results"), recorded);
+  std::ifstream results(session / "results" / "plots.jsonl");
+  std::set<std::string> plots;
+  for (std::string line; std::getline(results, line);)
+    plots.insert(Json::parse(line).at("location").get<std::string>());
+  EXPECT_EQ(plots.size(), static_cast<std::size_t>(recorded));
+}
+
 }  // namespace
 }  // namespace fieldrig

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "support/cli_run.h"
 #include "support/temp_dir.h"
@@ -105,6 +106,53 @@ TEST(ProcessCli, AMissingCameraGivesAFlaggedPartialPlotNotAFailure) {
   }
   EXPECT_TRUE(names_the_file) << line.dump();
   EXPECT_EQ(line.at("traits").at("status"), "ok") << "two heads still see the plot's base";
+}
+
+TEST(ProcessCli, ResumesSkipsWhatIsDoneRedoesWithForceAndSplitsIntoShards) {
+  ScopedTempDir dir("process_cli_resume");
+  const fs::path session = dir.path() / "session";
+  ASSERT_EQ(runFieldrig({"sim", "plots", "--out", session.string(), "--count", "3"}, dir.path())
+                .exit_code,
+            0);
+  const auto first = runFieldrig({"process", session.string()}, dir.path());
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const std::string results = readWholeFile(session / "results" / "plots.jsonl");
+  // Again: every set is already in the results, nothing is processed, nothing changes.
+  const auto again = runFieldrig({"process", session.string()}, dir.path());
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  ASSERT_EQ(again.out_lines.size(), 1U);
+  const Json resumed = Json::parse(again.out_lines.back()).at("summary");
+  EXPECT_EQ(resumed.at("sets"), 0);
+  EXPECT_EQ(resumed.at("already_done"), 3);
+  EXPECT_EQ(resumed.at("plots_in_results"), 3);
+  EXPECT_EQ(readWholeFile(session / "results" / "plots.jsonl"), results);
+  // A run cut short leaves a torn last line: the plot is done again, the others are kept.
+  const std::string torn = results.substr(0, results.size() - 40);
+  std::ofstream(session / "results" / "plots.jsonl", std::ios::trunc) << torn;
+  const auto after_crash = runFieldrig({"process", session.string()}, dir.path());
+  ASSERT_EQ(after_crash.exit_code, 0) << after_crash.err;
+  EXPECT_EQ(Json::parse(after_crash.out_lines.back()).at("summary").at("sets"), 1);
+  EXPECT_EQ(readWholeFile(session / "results" / "plots.jsonl"), results);
+  // --force processes every set again, into fresh files.
+  const auto forced = runFieldrig({"process", session.string(), "--force"}, dir.path());
+  ASSERT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_EQ(Json::parse(forced.out_lines.back()).at("summary").at("sets"), 3);
+  EXPECT_EQ(readWholeFile(session / "results" / "plots.jsonl"), results);
+  // Two shards: separate folders, every set in exactly one of them.
+  std::set<std::uint64_t> sets;
+  for (const char* shard : {"0/2", "1/2"}) {
+    const auto part = runFieldrig({"process", session.string(), "--shard", shard}, dir.path());
+    ASSERT_EQ(part.exit_code, 0) << part.err;
+    for (std::size_t i = 0; i + 1 < part.out_lines.size(); ++i)
+      EXPECT_TRUE(
+          sets.insert(Json::parse(part.out_lines[i]).at("set").get<std::uint64_t>()).second);
+  }
+  EXPECT_EQ(sets, (std::set<std::uint64_t>{0, 1, 2}));
+  EXPECT_TRUE(fs::exists(session / "results" / "shard-0-of-2" / "plots.jsonl"));
+  EXPECT_TRUE(fs::exists(session / "results" / "shard-1-of-2" / "plots.jsonl"));
+  const auto bad = runFieldrig({"process", session.string(), "--shard", "2/2"}, dir.path());
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--shard"), std::string::npos) << bad.err;
 }
 
 TEST(ProcessCli, BadCalibrationIsAClearError) {
