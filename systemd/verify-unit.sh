@@ -49,13 +49,16 @@ fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 if [[ -n $built_binary ]]; then
-  [[ -x $built_binary ]] || { echo "verify-unit: $built_binary is not built" >&2; exit 1; }
+  [[ -x $built_binary ]] || {
+    echo "verify-unit: $built_binary is not built (build fieldrigd first)" >&2
+    exit 1
+  }
   binary=$built_binary
 else
   binary=$work/fieldrigd
   printf '#!/bin/sh\nexit 0\n' >"$binary"
   chmod +x "$binary"
-  echo "verify-unit: no fieldrigd target yet: ExecStart= checked against a stub"
+  echo "verify-unit: no BUILT_BINARY given: ExecStart= checked against a stub"
 fi
 
 # The same file name: verify derives the unit's name and type from it.
