@@ -182,14 +182,44 @@ TEST(DaemonLive, ProcessingSlowerThanTheDriveLosesNothingAndFieldrigProcessCompl
   const fs::path field = testing_support::daemonField();
   ASSERT_TRUE(fs::exists(field / "drive.nmea")) << "the daemon_field fixture did not run";
   ScopedTempDir dir("daemon_slow");
-  // The paper's surface area (MLS + greedy triangulation, about 3.5 s a plot here) behind a
-  // one-set queue, with plots every 2 s in real time (the drive file played at its own pace
-  // through the daemon's pty): live processing must fall behind and skip.
+  // The field driven at 6 m/s (a plot every 0.67 s, played in real time through the daemon's
+  // pty) and the paper's surface area (MLS + greedy triangulation, 2-3 s a plot here) behind a
+  // one-set queue: live processing must fall behind and skip, whatever the machine's load.
+  const fs::path fast_nmea = dir.path() / "fast.nmea";
+  const auto drive = testing_support::runFieldrig({"sim",
+                                                   "drive",
+                                                   "--row-start",
+                                                   "42.0106,-93.7385",
+                                                   "--row-end",
+                                                   "42.0110,-93.7385",
+                                                   "--rows",
+                                                   "2",
+                                                   "--plots",
+                                                   "6",
+                                                   "--plot-length",
+                                                   "3",
+                                                   "--alley-length",
+                                                   "1",
+                                                   "--row-spacing",
+                                                   "2.286",
+                                                   "--start-offset",
+                                                   "1",
+                                                   "--speed",
+                                                   "6",
+                                                   "--seed",
+                                                   "7",
+                                                   "--out-nmea",
+                                                   fast_nmea.string(),
+                                                   "--out-map",
+                                                   (dir.path() / "fast-map.csv").string()},
+                                                  dir.path());
+  ASSERT_EQ(drive.exit_code, 0) << drive.err;
   const std::string slow_traits = "pipeline:\n  queue_sets: 1\n  traits:\n    area_method: paper\n";
-  const fs::path config = testing_support::writeReplayConfig(dir.path(), "run", field, "",
-                                                             slow_traits + "log:\n  level: info\n");
-  const auto run =
-      testing_support::runDaemon({"replay", "--config", config.string(), "--realtime"}, dir.path());
+  const fs::path config =
+      testing_support::writeReplayConfig(dir.path(), "run", field, "", slow_traits);
+  const auto run = testing_support::runDaemon(
+      {"replay", "--config", config.string(), "--realtime", "--nmea", fast_nmea.string()},
+      dir.path());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const Json summary = Json::parse(run.out_lines.back()).at("summary");
   // Which locations trigger is not this test's business: with both cores busy, the kernel has
