@@ -22,5 +22,19 @@ TEST(ResultTest, CarriesValueOrError) {
   EXPECT_EQ(bad.error().message, "odd: 7");
 }
 
+Result<void> mustBeEven(int value) {
+  if (value % 2 != 0)
+    return Error{"odd: " + std::to_string(value)};
+  return {};
+}
+
+TEST(ResultTest, VoidCarriesSuccessOrError) {
+  EXPECT_TRUE(mustBeEven(8).ok());
+  EXPECT_TRUE(static_cast<bool>(mustBeEven(0)));
+  const auto bad = mustBeEven(3);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message, "odd: 3");
+}
+
 }  // namespace
 }  // namespace fieldrig::core
