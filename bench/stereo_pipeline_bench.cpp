@@ -2,7 +2,7 @@
 // cloud, split per stage, for fieldrig's CloudBuilder (maps and matchers built once) in several
 // configurations, next to a straightforward per-head pipeline measured in the same run: default
 // SGBM (create(0, 128, 3), MODE_SGBM), rectification maps recomputed for every FrameSet,
-// reprojectImageTo3D and a loop over all pixels. Frames come from tests/cloud/synthetic_rig.h.
+// reprojectImageTo3D and a loop over all pixels. Frames come from tests/support/plane_rig_scene.h.
 // Usage: stereo_pipeline_bench [ITERATIONS]   (default 10; the first run of each is a warm-up)
 #include <chrono>
 #include <cstdio>
@@ -14,9 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "cloud/synthetic_rig.h"
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/core/time.h"
+#include "support/plane_rig_scene.h"
 
 namespace {
 
@@ -77,20 +77,20 @@ StageTimes runBuilder(cloud::CloudBuilder& builder, const std::vector<cloud::Hea
 }
 
 // The straightforward pipeline: everything per FrameSet, default SGBM.
-StageTimes runStraightforward(const cloud::RigConfig& rig,
+StageTimes runStraightforward(const cloud::RigCalibration& rig, const cloud::CloudOptions& options,
                               const std::vector<cloud::HeadFrames>& frames) {
   StageTimes t;
   const auto all = Clock::now();
   const double cpu_start = processCpuMs();
   cloud::Cloud fused;
   for (std::size_t i = 0; i < rig.heads.size(); ++i) {
-    const stereo::StereoCalibration c = rig.heads[i].calibration.scaled(rig.scale);
+    const stereo::StereoCalibration c = rig.heads[i].stereo.scaled(options.scale);
     auto start = Clock::now();
     cv::Mat left_full, right_full, left, right;
     cv::cvtColor(frames[i].left, left_full, cv::COLOR_BayerRGGB2BGR);
     cv::cvtColor(frames[i].right, right_full, cv::COLOR_BayerRGGB2BGR);
-    cv::resize(left_full, left, cv::Size(), rig.scale, rig.scale, cv::INTER_AREA);
-    cv::resize(right_full, right, cv::Size(), rig.scale, rig.scale, cv::INTER_AREA);
+    cv::resize(left_full, left, cv::Size(), options.scale, options.scale, cv::INTER_AREA);
+    cv::resize(right_full, right, cv::Size(), options.scale, options.scale, cv::INTER_AREA);
     t.debayer += fieldrig::core::millisecondsSince(start);
     start = Clock::now();
     cv::Mat m1x, m1y, m2x, m2y, left_rect, right_rect;
@@ -103,7 +103,8 @@ StageTimes runStraightforward(const cloud::RigConfig& rig,
     cv::Mat left_grey, right_grey, fixed, disparity;
     cv::cvtColor(left_rect, left_grey, cv::COLOR_BGR2GRAY);
     cv::cvtColor(right_rect, right_grey, cv::COLOR_BGR2GRAY);
-    cv::StereoSGBM::create(0, rig.num_disparities, 3)->compute(left_grey, right_grey, fixed);
+    cv::StereoSGBM::create(0, options.matcher.num_disparities, 3)
+        ->compute(left_grey, right_grey, fixed);
     t.sgbm += fieldrig::core::millisecondsSince(start);
     start = Clock::now();
     fixed.convertTo(disparity, CV_32F, 1.0 / 16);
@@ -121,7 +122,7 @@ StageTimes runStraightforward(const cloud::RigConfig& rig,
       for (int x = 0; x < xyz.cols; ++x) {
         const cv::Vec3f v = xyz.at<cv::Vec3f>(y, x);
         const cv::Vec4d p = to_plot * cv::Vec4d(v[0], v[1], v[2], 1);
-        if (!(p[2] > rig.min_depth_m && p[2] <= rig.max_depth_m))
+        if (!(p[2] > options.min_depth_m && p[2] <= options.max_depth_m))
           continue;
         const cv::Vec3b colour = left_rect.at<cv::Vec3b>(y, x);
         pcl::PointXYZRGB point;
@@ -146,7 +147,7 @@ StageTimes runStraightforward(const cloud::RigConfig& rig,
 
 int main(int argc, char** argv) {
   const int iterations = argc > 1 ? std::atoi(argv[1]) : 10;
-  const cloud::RigConfig rig = testing_support::syntheticRig();
+  const cloud::RigCalibration rig = testing_support::syntheticRig();
   std::vector<cloud::HeadFrames> frames;
   for (int i = 0; i < 3; ++i) {
     testing_support::RenderedHead head = testing_support::renderHead(i);
@@ -159,10 +160,11 @@ int main(int argc, char** argv) {
       "join | total | speed-up | CPU ms | points "
       "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
 
-  runStraightforward(rig, frames);
+  const cloud::CloudOptions defaults;
+  runStraightforward(rig, defaults, frames);
   StageTimes baseline;
   for (int i = 0; i < iterations; ++i)
-    baseline += runStraightforward(rig, frames);
+    baseline += runStraightforward(rig, defaults, frames);
   const double baseline_ms = baseline.total / iterations;
   printRow("straightforward (default SGBM, maps per set)", baseline, iterations, 0);
 
@@ -188,12 +190,14 @@ int main(int argc, char** argv) {
       {"fieldrig + WLS, heads in parallel", wls, true},
   };
   // The plants' range only (0.8–1.7 m is 101–48 px): disparities [32, 112).
-  cloud::RigConfig narrow = rig;
-  narrow.min_disparity = 32;
-  narrow.num_disparities = 80;
   for (const Config& config : configs) {
-    const bool narrow_range = config.name.find("[32, 112)") != std::string::npos;
-    auto builder = cloud::CloudBuilder::create(narrow_range ? narrow : rig, config.matcher);
+    cloud::CloudOptions options;
+    options.matcher = config.matcher;
+    if (config.name.find("[32, 112)") != std::string::npos) {
+      options.matcher.min_disparity = 32;
+      options.matcher.num_disparities = 80;
+    }
+    auto builder = cloud::CloudBuilder::create(rig, options);
     if (!builder) {
       std::fprintf(stderr, "%s\n", builder.error().message.c_str());
       return 1;

@@ -700,6 +700,28 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
   }
 }
 
+void readCloud(const Value& section, cloud::CloudOptions& o) {
+  const Entries entries =
+      readMap(section, {
+                           {"scale",
+                            [&](const Value& v) {
+                              const double scale = v.number();
+                              if (!(scale > 0 && scale <= 1))
+                                v.fail(v.node().Scalar() + " is out of range (0, 1]");
+                              o.scale = scale;
+                            }},
+                           {"min_depth_m", nonNegative(o.min_depth_m)},
+                           {"max_depth_m", positive(o.max_depth_m)},
+                           {"edge_max_jump_px", nonNegative(o.edge_max_jump_px)},
+                       });
+  if (!(o.min_depth_m < o.max_depth_m)) {
+    const Value& at = entries.contains("min_depth_m") ? entries.at("min_depth_m")
+                                                      : entryOr(entries, "max_depth_m", section);
+    at.fail("the depth crop must satisfy min_depth_m (" + formatNumber(o.min_depth_m) +
+            ") < max_depth_m (" + formatNumber(o.max_depth_m) + ")");
+  }
+}
+
 void readPipeline(const Value& section, PipelineConfig& pipeline) {
   readMap(section, {
                        {"enabled", flag(pipeline.enabled)},
@@ -708,7 +730,8 @@ void readPipeline(const Value& section, PipelineConfig& pipeline) {
                           pipeline.queue_sets = static_cast<std::size_t>(
                               readIntegerIn(v, 1, std::numeric_limits<std::int64_t>::max()));
                         }},
-                       {"matcher", [&](const Value& v) { readMatcher(v, pipeline.matcher); }},
+                       {"cloud", [&](const Value& v) { readCloud(v, pipeline.cloud); }},
+                       {"matcher", [&](const Value& v) { readMatcher(v, pipeline.cloud.matcher); }},
                        {"traits", [&](const Value& v) { readTraits(v, pipeline.traits); }},
                    });
 }

@@ -24,7 +24,7 @@
 #include <optional>
 #include <thread>
 
-#include "fieldrig/cloud/rig.h"
+#include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/core/logging.h"
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/acquisition.h"
@@ -186,13 +186,13 @@ class Daemon {
             sourceName());
         return kExitBadInput;
       }
-      auto rig = cloud::loadRig(config_.calibration);
+      auto rig = cloud::loadRigCalibration(config_.calibration);
       if (!rig) {
         spdlog::error("{}", rig.error().message);
         return kExitBadInput;
       }
       pipeline::ProcessorOptions processor_options;
-      processor_options.matcher = config_.pipeline.matcher;
+      processor_options.cloud = config_.pipeline.cloud;
       processor_options.traits = config_.pipeline.traits;
       auto processor = pipeline::PlotProcessor::create(*rig, processor_options);
       if (!processor) {

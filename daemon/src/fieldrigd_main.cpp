@@ -7,7 +7,7 @@
 
 #include <iostream>
 
-#include "fieldrig/cloud/rig.h"
+#include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/config/config.h"
 #include "fieldrig/core/logging.h"
 #include "fieldrig/daemon/daemon.h"
@@ -33,7 +33,7 @@ int checkConfig(const std::string& path) {
     }
   }
   if (config.pipeline.enabled && !config.calibration.empty()) {
-    if (auto rig = fieldrig::cloud::loadRig(config.calibration); !rig) {
+    if (auto rig = fieldrig::cloud::loadRigCalibration(config.calibration); !rig) {
       std::cerr << "fieldrigd: " << rig.error().message << '\n';
       return kExitBadInput;
     }

@@ -11,9 +11,9 @@ namespace {
 // The head images in the order of rig.heads: `fill(camera name, image, pixel format)` loads one
 // camera's image, or leaves it empty and says why in the caller's problems.
 template <typename Fill>
-std::vector<cloud::HeadFrames> perHead(const cloud::RigConfig& rig, Fill fill) {
+std::vector<cloud::HeadFrames> perHead(const cloud::RigCalibration& rig, Fill fill) {
   std::vector<cloud::HeadFrames> frames;
-  for (const cloud::HeadConfig& head : rig.heads) {
+  for (const cloud::HeadCalibration& head : rig.heads) {
     cloud::HeadFrames head_frames;
     for (const auto& [side, image] : {std::pair{core::CameraSide::kLeft, &head_frames.left},
                                       std::pair{core::CameraSide::kRight, &head_frames.right}}) {
@@ -27,8 +27,8 @@ std::vector<cloud::HeadFrames> perHead(const cloud::RigConfig& rig, Fill fill) {
 }  // namespace
 
 core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
-    const recording::SessionReader& reader, std::uint64_t set_index, const cloud::RigConfig& rig,
-    std::vector<std::string>& problems) {
+    const recording::SessionReader& reader, std::uint64_t set_index,
+    const cloud::RigCalibration& rig, std::vector<std::string>& problems) {
   const recording::IndexedSet* set = reader.bySetIndex(set_index);
   if (!set) {
     return core::Error{reader.dir().string() + ": no set with index " + std::to_string(set_index) +
@@ -58,7 +58,7 @@ core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
 
 std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,
                                                       const std::vector<std::string>& camera_names,
-                                                      const cloud::RigConfig& rig,
+                                                      const cloud::RigCalibration& rig,
                                                       std::vector<std::string>& problems) {
   return perHead(rig, [&](const std::string& camera, cv::Mat& image, core::PixelFormat& format) {
     const auto it = std::find(camera_names.begin(), camera_names.end(), camera);
@@ -99,8 +99,8 @@ std::optional<std::filesystem::path> sessionCalibrationDir(const std::string& ex
   return std::nullopt;
 }
 
-core::Result<cloud::RigConfig> loadRigFor(const std::string& explicit_dir,
-                                          const recording::SessionReader* reader) {
+core::Result<cloud::RigCalibration> loadRigFor(const std::string& explicit_dir,
+                                               const recording::SessionReader* reader) {
   std::optional<std::filesystem::path> dir;
   if (reader) {
     dir = sessionCalibrationDir(explicit_dir, *reader);
@@ -112,7 +112,7 @@ core::Result<cloud::RigConfig> loadRigFor(const std::string& explicit_dir,
         "no calibration: give --calib DIR (or record the session with a "
         "calibration reference named calib_dir)"};
   }
-  return cloud::loadRig(*dir);
+  return cloud::loadRigCalibration(*dir);
 }
 
 }  // namespace fieldrig::daemon

@@ -1,16 +1,16 @@
 // `fieldrig cloud`, run as the built binary on a recorded session and on image files from the
-// synthetic calibrated rig (tests/cloud/synthetic_rig.h): the PLY it writes, the flagged partial
-// cloud for a blank or missing camera, and clear errors for unusable calibration.
+// synthetic calibrated rig (tests/support/plane_rig_scene.h): the PLY it writes, the flagged
+// partial cloud for a blank or missing camera, and clear errors for unusable calibration.
 #include <gtest/gtest.h>
 #include <pcl/io/ply_io.h>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "cloud/synthetic_rig.h"
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/recording/session_writer.h"
 #include "support/cli_run.h"
+#include "support/plane_rig_scene.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig::cloud {
@@ -75,7 +75,7 @@ Json lastJson(const CliRun& run) {
 
 TEST(CloudCli, SessionSetToPlotFramePly) {
   ScopedTempDir dir("cloud_cli_session");
-  ASSERT_TRUE(saveRig(syntheticRig(), dir / "calib"));
+  ASSERT_TRUE(saveRigCalibration(syntheticRig(), dir / "calib"));
   writeSession(dir / "session", fixture().raw);
   const CliRun run = runFieldrig({"cloud", (dir / "session").string(), "--set", "0", "--calib",
                                   (dir / "calib").string(), "--out", (dir / "plot.ply").string()},
@@ -100,7 +100,7 @@ TEST(CloudCli, SessionSetToPlotFramePly) {
 
 TEST(CloudCli, CalibrationFromTheSessionsReference) {
   ScopedTempDir dir("cloud_cli_reference");
-  ASSERT_TRUE(saveRig(syntheticRig(), dir / "session_calib"));
+  ASSERT_TRUE(saveRigCalibration(syntheticRig(), dir / "session_calib"));
   // Relative to the session folder.
   writeSession(dir / "session", fixture().raw, "", "../session_calib");
   const CliRun run = runFieldrig(
@@ -112,7 +112,7 @@ TEST(CloudCli, CalibrationFromTheSessionsReference) {
 
 TEST(CloudCli, PairsOfFiles) {
   ScopedTempDir dir("cloud_cli_pairs");
-  ASSERT_TRUE(saveRig(syntheticRig(), dir / "calib"));
+  ASSERT_TRUE(saveRigCalibration(syntheticRig(), dir / "calib"));
   std::string pairs;
   for (int i = 0; i < 6; ++i) {
     const auto file = dir / (kCameras[static_cast<std::size_t>(i)] + ".pgm");
@@ -138,7 +138,7 @@ TEST(CloudCli, PairsOfFiles) {
 
 TEST(CloudCli, MissingCameraAndBlankFrameGiveFlaggedPartialCloud) {
   ScopedTempDir dir("cloud_cli_partial");
-  ASSERT_TRUE(saveRig(syntheticRig(), dir / "calib"));
+  ASSERT_TRUE(saveRigCalibration(syntheticRig(), dir / "calib"));
   std::vector<cv::Mat> frames = fixture().raw;
   frames[2] = cv::Mat::zeros(kCameraSize, CV_8UC1);  // middle_left: all black
   writeSession(dir / "session", frames, "top_right");
@@ -170,10 +170,10 @@ TEST(CloudCli, UnusableCalibrationIsAClearError) {
       << no_calib.err;
 
   // Calibrated for another camera size: every head is refused, nothing is written.
-  RigConfig other = syntheticRig();
-  for (HeadConfig& head : other.heads)
-    head.calibration.image_size = cv::Size(1280, 960);
-  ASSERT_TRUE(saveRig(other, dir / "calib"));
+  RigCalibration other = syntheticRig();
+  for (HeadCalibration& head : other.heads)
+    head.stereo.image_size = cv::Size(1280, 960);
+  ASSERT_TRUE(saveRigCalibration(other, dir / "calib"));
   const CliRun mismatched =
       runFieldrig({"cloud", (dir / "session").string(), "--set", "0", "--calib",
                    (dir / "calib").string(), "--out", (dir / "x.ply").string()},

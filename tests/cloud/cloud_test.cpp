@@ -1,4 +1,4 @@
-// The fused cloud from a synthetic calibrated rig (tests/cloud/synthetic_rig.h): each head's
+// The fused cloud from a synthetic calibrated rig (tests/support/plane_rig_scene.h): each head's
 // points back in its own frame lie on its plane, everything beyond the crop depth is gone, a
 // head with bad frames is flagged and the others still give their points; rig.yml round trip
 // and its errors.
@@ -10,9 +10,9 @@
 #include <fstream>
 #include <vector>
 
-#include "cloud/synthetic_rig.h"
 #include "fieldrig/cloud/fusion.h"
-#include "fieldrig/cloud/rig.h"
+#include "fieldrig/cloud/rig_calibration.h"
+#include "support/plane_rig_scene.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig::cloud {
@@ -29,7 +29,7 @@ std::vector<HeadFrames> renderAll() {
   return frames;
 }
 
-cv::Matx44d toPlot(const RigConfig& rig, int head) {
+cv::Matx44d toPlot(const RigCalibration& rig, int head) {
   cv::Matx44d plot = cv::Matx44d::eye();
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c)
@@ -57,7 +57,7 @@ double quantile(const std::vector<double>& sorted, double q) {
 }
 
 TEST(CloudBuilder, SyntheticRigPointsLieOnTheirPlanesInThePlotFrame) {
-  const RigConfig rig = syntheticRig();
+  const RigCalibration rig = syntheticRig();
   auto builder = CloudBuilder::create(rig);
   ASSERT_TRUE(builder) << builder.error().message;
   const FusionResult result = builder->build(renderAll());
@@ -83,8 +83,8 @@ TEST(CloudBuilder, SyntheticRigPointsLieOnTheirPlanesInThePlotFrame) {
   }
   EXPECT_EQ(first, result.cloud.size());
   for (const auto& p : result.cloud) {
-    ASSERT_LE(p.z, rig.max_depth_m);
-    ASSERT_GT(p.z, rig.min_depth_m);
+    ASSERT_LE(p.z, builder->options().max_depth_m);
+    ASSERT_GT(p.z, builder->options().min_depth_m);
   }
   // The plot frame: x up. The middle head sits 0.5 m above the bottom one and sees the same
   // field of view, so its points are 0.5 m higher on average.
@@ -106,7 +106,7 @@ TEST(CloudBuilder, SyntheticRigPointsLieOnTheirPlanesInThePlotFrame) {
 }
 
 TEST(CloudBuilder, BlankOrMissingFramesFlagTheHeadAndKeepTheOthers) {
-  const RigConfig rig = syntheticRig();
+  const RigCalibration rig = syntheticRig();
   auto builder = CloudBuilder::create(rig);
   ASSERT_TRUE(builder);
   std::vector<HeadFrames> frames = renderAll();
@@ -124,7 +124,7 @@ TEST(CloudBuilder, BlankOrMissingFramesFlagTheHeadAndKeepTheOthers) {
 }
 
 TEST(CloudBuilder, WrongSizesFlagTheHead) {
-  const RigConfig rig = syntheticRig();
+  const RigCalibration rig = syntheticRig();
   auto builder = CloudBuilder::create(rig);
   ASSERT_TRUE(builder);
   std::vector<HeadFrames> frames = renderAll();
@@ -165,32 +165,28 @@ TEST(DepthEdges, BlendedPixelsAtAStepGoAndSlopesStay) {
 
 TEST(Rig, SaveLoadRoundTrip) {
   ScopedTempDir dir("cloud_rig_round_trip");
-  RigConfig rig = syntheticRig();
-  rig.max_depth_m = 1.5;
-  rig.edge_max_jump_px = 3.5;
+  RigCalibration rig = syntheticRig();
   rig.pixel_format = core::PixelFormat::kBayerGB8;
-  ASSERT_TRUE(saveRig(rig, dir.path()));
-  auto loaded = loadRig(dir.path());
+  ASSERT_TRUE(saveRigCalibration(rig, dir.path()));
+  auto loaded = loadRigCalibration(dir.path());
   ASSERT_TRUE(loaded) << loaded.error().message;
   ASSERT_EQ(loaded->heads.size(), 3u);
   EXPECT_EQ(loaded->heads[2].name, "top");
   EXPECT_LT(cv::norm(loaded->heads[2].to_bottom - rig.heads[2].to_bottom), 1e-12);
-  EXPECT_EQ(loaded->heads[1].calibration.image_size, kCameraSize);
-  EXPECT_DOUBLE_EQ(loaded->max_depth_m, 1.5);
-  EXPECT_DOUBLE_EQ(loaded->edge_max_jump_px, 3.5);
+  EXPECT_EQ(loaded->heads[1].stereo.image_size, kCameraSize);
   EXPECT_EQ(loaded->pixel_format, core::PixelFormat::kBayerGB8);
   EXPECT_LT(cv::norm(cv::Mat(loaded->plot_rotation), cv::Mat(rig.plot_rotation)), 1e-12);
 }
 
 TEST(Rig, ErrorsNameFileAndField) {
   ScopedTempDir dir("cloud_rig_errors");
-  auto missing = loadRig(dir.path());
+  auto missing = loadRigCalibration(dir.path());
   ASSERT_FALSE(missing);
   EXPECT_EQ(missing.error().message, (dir.path() / "rig.yml").string() + ": cannot open");
 
-  ASSERT_TRUE(saveRig(syntheticRig(), dir.path()));
+  ASSERT_TRUE(saveRigCalibration(syntheticRig(), dir.path()));
   std::filesystem::remove(dir.path() / "middle" / "extrinsics.yml");
-  auto no_head = loadRig(dir.path());
+  auto no_head = loadRigCalibration(dir.path());
   ASSERT_FALSE(no_head);
   EXPECT_EQ(no_head.error().message,
             (dir.path() / "middle" / "extrinsics.yml").string() + ": cannot open");
@@ -200,11 +196,64 @@ TEST(Rig, ErrorsNameFileAndField) {
     out << "%YAML:1.0\nheads: [bottom]\nplot_rotation: !!opencv-matrix\n  rows: 3\n  cols: 3\n"
            "  dt: d\n  data: [ 2, 0, 0, 0, 1, 0, 0, 0, 1 ]\n";
   }
-  auto not_rotation = loadRig(dir.path());
+  auto not_rotation = loadRigCalibration(dir.path());
   ASSERT_FALSE(not_rotation);
   EXPECT_EQ(
       not_rotation.error().message,
       (dir.path() / "rig.yml").string() + ": field 'plot_rotation' is not a 3x3 rotation matrix");
+}
+
+// Calibrations written before the processing options left rig.yml carry them at their defaults:
+// they still load; a changed value is refused with where it belongs now, never dropped silently.
+TEST(Rig, ProcessingOptionsOfEarlierRigFilesLoadAtDefaultsAndAreRefusedOtherwise) {
+  ScopedTempDir dir("cloud_rig_legacy");
+  ASSERT_TRUE(saveRigCalibration(syntheticRig(), dir.path()));
+  const std::filesystem::path file = dir.path() / "rig.yml";
+  std::string text;
+  {
+    std::ifstream in(file);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  auto writeWith = [&](const std::string& extra) {
+    std::ofstream out(file, std::ios::trunc);
+    out << text << extra;
+  };
+  writeWith(
+      "max_depth_m: 1.7\nmin_depth_m: 0.2\nscale: 0.5\nmin_disparity: 0\n"
+      "num_disparities: 128\nedge_max_jump_px: 2.\n");
+  auto at_defaults = loadRigCalibration(dir.path());
+  ASSERT_TRUE(at_defaults) << at_defaults.error().message;
+  EXPECT_EQ(at_defaults->heads.size(), 3u);
+
+  writeWith("scale: 0.25\n");
+  auto changed = loadRigCalibration(dir.path());
+  ASSERT_FALSE(changed);
+  EXPECT_EQ(changed.error().message,
+            file.string() +
+                ": field 'scale' is a processing option, no longer part of the calibration: set "
+                "it as pipeline.cloud.scale in the configuration and remove it here");
+  writeWith("num_disparities: 64\n");
+  auto disparities = loadRigCalibration(dir.path());
+  ASSERT_FALSE(disparities);
+  EXPECT_NE(disparities.error().message.find("pipeline.matcher.num_disparities"), std::string::npos)
+      << disparities.error().message;
+}
+
+TEST(CloudBuilder, RefusesOptionsOutOfRange) {
+  CloudOptions options;
+  options.scale = std::numeric_limits<double>::quiet_NaN();
+  auto nan_scale = CloudBuilder::create(syntheticRig(), options);
+  ASSERT_FALSE(nan_scale);
+  EXPECT_EQ(nan_scale.error().message.rfind("cloud options: scale", 0), 0u)
+      << nan_scale.error().message;
+  options = {};
+  options.min_depth_m = 2.0;
+  auto crop = CloudBuilder::create(syntheticRig(), options);
+  ASSERT_FALSE(crop);
+  EXPECT_NE(crop.error().message.find("min_depth_m"), std::string::npos) << crop.error().message;
+  options = {};
+  options.matcher.num_disparities = 100;
+  EXPECT_FALSE(CloudBuilder::create(syntheticRig(), options));
 }
 
 TEST(Ply, WritesBinaryWithColourAndRefusesEmpty) {

@@ -91,6 +91,14 @@ void expectSame(const stereo::MatcherOptions& actual, const stereo::MatcherOptio
   EXPECT_FIELD(match_colour);
 }
 
+void expectSame(const cloud::CloudOptions& actual, const cloud::CloudOptions& expected) {
+  EXPECT_FIELD(scale);
+  EXPECT_FIELD(min_depth_m);
+  EXPECT_FIELD(max_depth_m);
+  EXPECT_FIELD(edge_max_jump_px);
+  expectSame(actual.matcher, expected.matcher);
+}
+
 void expectSame(const traits::TraitsOptions& actual, const traits::TraitsOptions& expected) {
   EXPECT_TRUE(actual.camera_to_plot == expected.camera_to_plot)
       << "camera_to_plot\n"
@@ -148,7 +156,7 @@ void expectDefaults(const Config& config) {
   EXPECT_EQ(config.recording.writer.fsync, recording::WriterOptions().fsync);
   EXPECT_EQ(config.pipeline.enabled, defaults.pipeline.enabled);
   EXPECT_EQ(config.pipeline.queue_sets, defaults.pipeline.queue_sets);
-  expectSame(config.pipeline.matcher, stereo::MatcherOptions());
+  expectSame(config.pipeline.cloud, cloud::CloudOptions());
   expectSame(config.pipeline.traits, traits::TraitsOptions());
   EXPECT_EQ(config.outputs.dir, fs::path());
   EXPECT_EQ(config.outputs.csv, defaults.outputs.csv);
@@ -191,7 +199,9 @@ const std::map<std::string, std::function<void(const Config&)>>& shippedFileChec
          EXPECT_EQ(c.calibration, fs::path("/etc/fieldrig/calib"));
          EXPECT_EQ(c.recording.dir, fs::path("/var/lib/fieldrig/sessions/today"));
          EXPECT_EQ(c.recording.writer.fsync, recording::FsyncPolicy::kPerSet);
-         EXPECT_EQ(c.pipeline.matcher.mode, cv::StereoSGBM::MODE_SGBM_3WAY);
+         EXPECT_EQ(c.pipeline.cloud.matcher.mode, cv::StereoSGBM::MODE_SGBM_3WAY);
+         EXPECT_EQ(c.pipeline.cloud.scale, 0.5);
+         EXPECT_EQ(c.pipeline.cloud.max_depth_m, 1.7);
          EXPECT_EQ(c.status.address, "127.0.0.1");
          EXPECT_EQ(c.status.port, 8470);
          EXPECT_TRUE(c.replay.nmea.empty());
@@ -311,6 +321,15 @@ TEST_F(ConfigErrors, OutOfRangeValuesAreRefused) {
               "pipeline.matcher.num_disparities", "not a positive multiple of 16");
   expectError("pipeline:\n  matcher:\n    block_size: 4\n", 3, "pipeline.matcher.block_size",
               "4 is even");
+  expectError("pipeline:\n  cloud:\n    scale: 1.5\n", 3, "pipeline.cloud.scale",
+              "1.5 is out of range (0, 1]");
+  expectError("pipeline:\n  cloud:\n    scale: 0\n", 3, "pipeline.cloud.scale",
+              "0 is out of range (0, 1]");
+  expectError("pipeline:\n  cloud:\n    min_depth_m: 2\n    max_depth_m: 1.5\n", 3,
+              "pipeline.cloud.min_depth_m",
+              "the depth crop must satisfy min_depth_m (2) < max_depth_m (1.5)");
+  expectError("pipeline:\n  cloud:\n    edge_max_jump_px: -1\n", 3,
+              "pipeline.cloud.edge_max_jump_px", "must not be negative");
   expectError("status:\n  port: 65536\n", 2, "status.port", "65536 is out of range (0 … 65535)");
   expectError("gps:\n  planner:\n    late_tolerance_m: -0.1\n", 3, "gps.planner.late_tolerance_m",
               "-0.1 must not be negative");
@@ -534,6 +553,7 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
       "pipeline:\n"
       "  enabled: false\n"
       "  queue_sets: 3\n"
+      "  cloud: {scale: 0.25, min_depth_m: 0.3, max_depth_m: 2.5, edge_max_jump_px: 0}\n"
       "  matcher:\n"
       "    num_disparities: 64\n"
       "    min_disparity: -8\n"
@@ -599,7 +619,13 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
   matcher.wls_sigma = 1.2;
   matcher.mode = cv::StereoSGBM::MODE_HH4;
   matcher.match_colour = true;
-  expectSame(c.pipeline.matcher, matcher);
+  cloud::CloudOptions cloud_options;
+  cloud_options.scale = 0.25;
+  cloud_options.min_depth_m = 0.3;
+  cloud_options.max_depth_m = 2.5;
+  cloud_options.edge_max_jump_px = 0;
+  cloud_options.matcher = matcher;
+  expectSame(c.pipeline.cloud, cloud_options);
   EXPECT_FALSE(c.outputs.csv);
   EXPECT_FALSE(c.outputs.geojson);
   EXPECT_FALSE(c.outputs.jsonl);

@@ -1,8 +1,9 @@
-// A synthetic calibrated three-head rig for the cloud tests and benchmark: ideal Grasshopper-like
-// heads (1624×1224, f 1350 px, baseline 0.12 m), the middle and top heads above the bottom one
-// (the top one tilted down), each looking at a textured fronto-parallel plane at a known depth
-// over its upper two thirds and at a background plane beyond the crop depth below. Right images
-// are the left texture shifted by the exact disparity; frames are mosaicked to raw Bayer.
+// A scene of planes for the cloud tests and benchmark, seen by sim's ideal three-head rig
+// (sim::idealRig: 1624×1224, f 1350 px, baseline 0.12 m) with the middle and top heads above the
+// bottom one (the top one tilted down): each head looks at a textured fronto-parallel plane at a
+// known depth over its upper two thirds and at a background plane beyond the crop depth below.
+// Right images are the left texture shifted by the exact disparity; frames are mosaicked to raw
+// Bayer.
 #pragma once
 
 #include <array>
@@ -11,44 +12,26 @@
 #include <string>
 #include <vector>
 
-#include "fieldrig/cloud/rig.h"
+#include "fieldrig/cloud/rig_calibration.h"
+#include "fieldrig/sim/synthetic_field.h"
 #include "fieldrig/stereo/preprocess.h"
 
 namespace fieldrig::testing_support {
 
-inline constexpr double kFocalPx = 1350;
-inline constexpr double kBaselineM = 0.12;
-inline const cv::Size kCameraSize(1624, 1224);
+inline constexpr double kFocalPx = sim::kIdealFocalPx;
+inline constexpr double kBaselineM = sim::kIdealBaselineM;
+inline const cv::Size kCameraSize(sim::kIdealImageWidth, sim::kIdealImageHeight);
 inline constexpr double kPlantDepthM[3] = {1.2, 1.0, 1.4};  // each head's near plane
 inline constexpr double kBackgroundDepthM = 2.4;
 inline constexpr int kNearRows = 1224 * 2 / 3;  // of kCameraSize.height
 
-inline stereo::StereoCalibration idealHead() {
-  return stereo::idealStereoCalibration(kFocalPx, kCameraSize, kBaselineM);
-}
-
-// bottom: reference; middle: 0.5 m above; top: 1.0 m above and tilted 20° down about x.
-inline cloud::RigConfig syntheticRig() {
-  cloud::RigConfig rig;
-  const std::array<std::string, 3> names{"bottom", "middle", "top"};
-  for (int i = 0; i < 3; ++i) {
-    cloud::HeadConfig head;
-    head.name = names[static_cast<std::size_t>(i)];
-    head.calibration = idealHead();
-    head.to_bottom = cv::Matx44d::eye();
-    head.to_bottom(1, 3) = -0.5 * i;  // bottom frame y points down
-    rig.heads.push_back(head);
-  }
-  const double tilt = 20.0 * CV_PI / 180.0;
-  // Top head frame → bottom frame: its z axis turned towards +y (down) by the tilt.
-  cv::Matx44d& top = rig.heads[2].to_bottom;
-  top(1, 1) = std::cos(tilt);
-  top(1, 2) = std::sin(tilt);
-  top(2, 1) = -std::sin(tilt);
-  top(2, 2) = std::cos(tilt);
-  rig.max_depth_m = 1.7;
-  rig.pixel_format = core::PixelFormat::kBayerRG8;
-  return rig;
+// sim's ideal rig with the heads 0.5 m apart and the top one tilted 20° down, so that the fusion
+// is tested with a rotation as well as offsets.
+inline cloud::RigCalibration syntheticRig() {
+  sim::IdealRigGeometry geometry;
+  geometry.head_heights_m = {0.5, 1.0, 1.5};
+  geometry.head_tilts_down_deg = {0, 0, 20};
+  return sim::idealRig(geometry);
 }
 
 // A smooth random colour texture (features of ~3 px) of the given size.

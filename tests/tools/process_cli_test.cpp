@@ -168,5 +168,37 @@ TEST(ProcessCli, BadCalibrationIsAClearError) {
   EXPECT_TRUE(run.out_lines.empty());
 }
 
+// `--config` takes the daemon's processing options: a depth crop that ends before the plants
+// (0.3–0.5 m from the camera; they stand 1.2 m away) leaves no points, and a bad key is an error
+// naming the file's line and key.
+TEST(ProcessCli, ConfigFileSetsTheProcessingOptions) {
+  ScopedTempDir dir("process_cli_config");
+  const fs::path session = dir.path() / "session";
+  ASSERT_EQ(runFieldrig({"sim", "plots", "--out", session.string(), "--count", "1"}, dir.path())
+                .exit_code,
+            0);
+  const fs::path config = dir.path() / "near.yaml";
+  std::ofstream(config) << "pipeline:\n  cloud:\n    min_depth_m: 0.3\n    max_depth_m: 0.5\n";
+  const auto near = runFieldrig({"process", session.string(), "--config", config.string(), "--out",
+                                 (dir.path() / "near").string()},
+                                dir.path());
+  ASSERT_EQ(near.exit_code, 0) << near.err;
+  ASSERT_EQ(near.out_lines.size(), 2U) << near.err;
+  const Json cropped = Json::parse(near.out_lines.front());
+  EXPECT_EQ(cropped.at("cloud_points").get<std::size_t>(), 0U) << cropped.dump();
+  EXPECT_NE(cropped.at("traits").at("status"), "ok") << cropped.dump();
+
+  const auto defaults = runFieldrig(
+      {"process", session.string(), "--out", (dir.path() / "default").string()}, dir.path());
+  ASSERT_EQ(defaults.exit_code, 0) << defaults.err;
+  EXPECT_GT(Json::parse(defaults.out_lines.front()).at("cloud_points").get<std::size_t>(), 1000U);
+
+  std::ofstream(config, std::ios::trunc) << "pipeline:\n  cloud:\n    scale: 2\n";
+  const auto bad =
+      runFieldrig({"process", session.string(), "--config", config.string()}, dir.path());
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("near.yaml:3: pipeline.cloud.scale"), std::string::npos) << bad.err;
+}
+
 }  // namespace
 }  // namespace fieldrig

@@ -1,5 +1,6 @@
-// `fieldrig process SESSION [--calib DIR] [--map MAP.csv] [--traits-config FILE] [--out DIR]
-//  [--shard K/N] [--force] [--clouds]`: every FrameSet of a recorded session through the plot
+// `fieldrig process SESSION [--calib DIR] [--map MAP.csv] [--config FILE] [--traits-config FILE]
+//  [--out DIR] [--shard K/N] [--force] [--clouds]`: every FrameSet of a recorded session through
+//  the plot
 // processor (three heads → fused cloud → plot traits), the daemon's own, into the results folder
 // (plots.jsonl, plots.csv, plots.geojson; daemon/results_writer.h) and one JSON line per set on
 // stdout. It resumes: sets already in the folder's plots.jsonl (by trigger id) are skipped unless
@@ -28,7 +29,7 @@ namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 struct ProcessArgs {
-  std::string session, calib, map, traits_config, out, shard;
+  std::string session, calib, map, config, traits_config, out, shard;
   bool clouds = false;
   bool force = false;
 };
@@ -80,7 +81,16 @@ int runProcess(const ProcessArgs& args) {
   }
   pipeline::ProcessorOptions options;
   options.keep_cloud = args.clouds;
-  if (!args.traits_config.empty()) {
+  if (!args.config.empty()) {  // the daemon's file: its processing options, nothing else
+    auto loaded = config::loadConfig(args.config);
+    if (!loaded) {
+      std::cerr << who << loaded.error().message << '\n';
+      return kExitBadInput;
+    }
+    options.cloud = loaded->pipeline.cloud;
+    options.traits = loaded->pipeline.traits;
+  }
+  if (!args.traits_config.empty()) {  // overrides the configuration's traits
     auto loaded = config::loadTraitsOptions(args.traits_config);
     if (!loaded) {
       std::cerr << who << loaded.error().message << '\n';
@@ -190,8 +200,13 @@ void registerProcessCommand(CLI::App& app, int& exit_code) {
                       "Calibration folder (rig.yml + one folder per head); default: the "
                       "session's calib_dir reference");
   process->add_option("--map", args->map, "Location map: plots placed at their map location");
+  process->add_option("--config", args->config,
+                      "fieldrigd configuration (YAML) whose pipeline.cloud, pipeline.matcher and "
+                      "pipeline.traits are used, so that a session is processed as the daemon "
+                      "processed it");
   process->add_option("--traits-config", args->traits_config,
-                      "Traits options (YAML or JSON: the keys of pipeline.traits)");
+                      "Traits options (YAML or JSON: the keys of pipeline.traits); override "
+                      "--config's");
   process->add_option("--out", args->out,
                       "Output folder (default SESSION/results, or SESSION/results/shard-K-of-N)");
   process->add_option("--shard", args->shard,

@@ -20,7 +20,7 @@
 
 #include "commands/commands.h"
 #include "fieldrig/cloud/fusion.h"
-#include "fieldrig/cloud/rig.h"
+#include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/recording/session_reader.h"
@@ -388,9 +388,9 @@ int runCloud(const CloudArgs& args) {
       frames.push_back(std::move(head_frames));
     }
   }
-  stereo::MatcherOptions matcher;
-  matcher.wls = args.wls;
-  auto builder = cloud::CloudBuilder::create(*rig, matcher);
+  cloud::CloudOptions options;
+  options.matcher.wls = args.wls;
+  auto builder = cloud::CloudBuilder::create(*rig, options);
   if (!builder) {
     std::cerr << who << builder.error().message << '\n';
     return kExitBadInput;

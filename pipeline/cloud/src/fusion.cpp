@@ -92,26 +92,26 @@ std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump) {
   return dropped;
 }
 
-core::Result<CloudBuilder> CloudBuilder::create(const RigConfig& rig,
-                                                stereo::MatcherOptions matcher) {
+core::Result<CloudBuilder> CloudBuilder::create(const RigCalibration& rig, CloudOptions options) {
   if (rig.heads.empty()) {
     return core::Error{"the rig has no heads"};
   }
+  if (auto valid = validate(options); !valid)
+    return core::Error{"cloud options: " + valid.error().message};
   CloudBuilder builder;
   builder.rig_ = rig;
-  stereo::HeadOptions options;
-  options.scale = rig.scale;
-  options.matcher = matcher;
-  options.matcher.num_disparities = rig.num_disparities;
-  options.matcher.min_disparity = rig.min_disparity;
+  builder.options_ = options;
+  stereo::HeadOptions head_options;
+  head_options.scale = options.scale;
+  head_options.matcher = options.matcher;
   cv::Matx44d plot = cv::Matx44d::eye();
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c)
       plot(r, c) = rig.plot_rotation(r, c);
   }
-  for (const HeadConfig& head : rig.heads) {
+  for (const HeadCalibration& head : rig.heads) {
     core::Result<stereo::HeadPipeline> pipeline =
-        stereo::HeadPipeline::create(head.calibration, options);
+        stereo::HeadPipeline::create(head.stereo, head_options);
     if (!pipeline)
       return core::Error{head.name + " head: " + pipeline.error().message};
     builder.heads_.push_back(std::move(*pipeline));
@@ -140,11 +140,11 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
         status.problem = output.error().message;
         return;
       }
-      if (rig_.edge_max_jump_px > 0)
-        status.edge_pixels = dropDepthEdges(output->disparity, rig_.edge_max_jump_px);
+      if (options_.edge_max_jump_px > 0)
+        status.edge_pixels = dropDepthEdges(output->disparity, options_.edge_max_jump_px);
       status.points = appendReprojected(
           output->disparity, output->left_bgr, heads_[i].matchingCalibration().Q, to_plot_[i],
-          rig_.min_depth_m, rig_.max_depth_m, head_clouds[i], &status.reproject_ms);
+          options_.min_depth_m, options_.max_depth_m, head_clouds[i], &status.reproject_ms);
       status.ok = true;
     } catch (const cv::Exception& e) {
       status.problem = status.name + ": OpenCV failed: " + e.what();

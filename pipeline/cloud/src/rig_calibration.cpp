@@ -1,6 +1,8 @@
-#include "fieldrig/cloud/rig.h"
+#include "fieldrig/cloud/rig_calibration.h"
 
 #include <cmath>
+
+#include "fieldrig/cloud/cloud_options.h"
 
 namespace fieldrig::cloud {
 namespace {
@@ -29,7 +31,7 @@ bool isRotation(const cv::Matx33d& r) {
 
 }  // namespace
 
-core::Result<RigConfig> loadRig(const fs::path& directory) {
+core::Result<RigCalibration> loadRigCalibration(const fs::path& directory) {
   const fs::path file = directory / "rig.yml";
   // Checked first so that OpenCV does not log its own error for a missing file.
   std::error_code ec;
@@ -45,13 +47,13 @@ core::Result<RigConfig> loadRig(const fs::path& directory) {
   if (!storage.isOpened()) {
     return Error{file.string() + ": cannot open"};
   }
-  RigConfig rig;
+  RigCalibration rig;
   const cv::FileNode heads = storage["heads"];
   if (heads.empty() || !heads.isSeq()) {
     return Error{file.string() + ": field 'heads' is missing or not a list of head names"};
   }
   for (const cv::FileNode& head_node : heads) {
-    HeadConfig head;
+    HeadCalibration head;
     if (!head_node.isString()) {
       return Error{file.string() + ": field 'heads' holds something that is not a name"};
     }
@@ -80,7 +82,7 @@ core::Result<RigConfig> loadRig(const fs::path& directory) {
       return Error{(directory / head.name / "intrinsics.yml").string() +
                    ": fields 'image_width'/'image_height' are missing (the cameras' size)"};
     }
-    head.calibration = std::move(*calibration);
+    head.stereo = std::move(*calibration);
     rig.heads.push_back(std::move(head));
   }
   if (!storage["plot_rotation"].empty()) {
@@ -90,37 +92,31 @@ core::Result<RigConfig> loadRig(const fs::path& directory) {
     }
     rig.plot_rotation = cv::Matx33d(rotation);
   }
-  auto readNumber = [&](const char* key, double& value) -> bool {
+  // Processing options that earlier versions wrote here, each with the default they were written
+  // with (CloudOptions' own): such a file still loads; a changed value must move to the
+  // configuration, where it takes effect, rather than be ignored here.
+  const CloudOptions defaults;
+  const std::pair<const char*, double> legacy_options[] = {
+      {"max_depth_m", defaults.max_depth_m},
+      {"min_depth_m", defaults.min_depth_m},
+      {"scale", defaults.scale},
+      {"min_disparity", defaults.matcher.min_disparity},
+      {"num_disparities", defaults.matcher.num_disparities},
+      {"edge_max_jump_px", defaults.edge_max_jump_px},
+  };
+  for (const auto& [key, default_value] : legacy_options) {
     const cv::FileNode node = storage[key];
     if (node.empty())
-      return true;
-    if (!node.isReal() && !node.isInt())
-      return false;
-    value = static_cast<double>(node);
-    return std::isfinite(value);
-  };
-  double num_disparities = rig.num_disparities;
-  double min_disparity = rig.min_disparity;
-  if (!readNumber("max_depth_m", rig.max_depth_m) || !readNumber("min_depth_m", rig.min_depth_m) ||
-      !readNumber("scale", rig.scale) || !readNumber("num_disparities", num_disparities) ||
-      !readNumber("min_disparity", min_disparity) ||
-      !readNumber("edge_max_jump_px", rig.edge_max_jump_px)) {
-    return Error{file.string() +
-                 ": one of 'max_depth_m', 'min_depth_m', 'scale', 'num_disparities', "
-                 "'min_disparity', 'edge_max_jump_px' is not a number"};
-  }
-  rig.num_disparities = static_cast<int>(num_disparities);
-  rig.min_disparity = static_cast<int>(min_disparity);
-  if (rig.num_disparities <= 0 || rig.num_disparities % 16 != 0 || rig.min_disparity < 0) {
-    return Error{file.string() +
-                 ": field 'num_disparities' must be a positive multiple of 16 and "
-                 "'min_disparity' not negative"};
-  }
-  if (!(rig.scale > 0 && rig.scale <= 1)) {
-    return Error{file.string() + ": field 'scale' must be in (0, 1]"};
-  }
-  if (!(rig.max_depth_m > rig.min_depth_m)) {
-    return Error{file.string() + ": field 'max_depth_m' must exceed 'min_depth_m'"};
+      continue;
+    const bool is_default =
+        (node.isReal() || node.isInt()) && static_cast<double>(node) == default_value;
+    if (!is_default) {
+      return Error{file.string() + ": field '" + key +
+                   "' is a processing option, no longer part of the calibration: set it as " +
+                   (std::string(key).find("disparit") != std::string::npos ? "pipeline.matcher."
+                                                                           : "pipeline.cloud.") +
+                   key + " in the configuration and remove it here"};
+    }
   }
   if (!storage["pixel_format"].empty()) {
     const std::string name = static_cast<std::string>(storage["pixel_format"]);
@@ -133,10 +129,10 @@ core::Result<RigConfig> loadRig(const fs::path& directory) {
   return rig;
 }
 
-core::Result<fs::path> saveRig(const RigConfig& rig, const fs::path& directory) {
-  for (const HeadConfig& head : rig.heads) {
+core::Result<fs::path> saveRigCalibration(const RigCalibration& rig, const fs::path& directory) {
+  for (const HeadCalibration& head : rig.heads) {
     core::Result<fs::path> saved =
-        stereo::saveStereoCalibration(head.calibration, directory / head.name);
+        stereo::saveStereoCalibration(head.stereo, directory / head.name);
     if (!saved)
       return saved.error();
   }
@@ -147,17 +143,14 @@ core::Result<fs::path> saveRig(const RigConfig& rig, const fs::path& directory) 
       return Error{file.string() + ": cannot write"};
     storage << "heads"
             << "[";
-    for (const HeadConfig& head : rig.heads)
+    for (const HeadCalibration& head : rig.heads)
       storage << head.name;
     storage << "]";
-    for (const HeadConfig& head : rig.heads) {
+    for (const HeadCalibration& head : rig.heads) {
       storage << head.name + "_to_bottom" << cv::Mat(head.to_bottom);
     }
-    storage << "plot_rotation" << cv::Mat(rig.plot_rotation) << "max_depth_m" << rig.max_depth_m
-            << "min_depth_m" << rig.min_depth_m << "pixel_format"
-            << std::string(core::toString(rig.pixel_format)) << "scale" << rig.scale
-            << "min_disparity" << rig.min_disparity << "num_disparities" << rig.num_disparities
-            << "edge_max_jump_px" << rig.edge_max_jump_px;
+    storage << "plot_rotation" << cv::Mat(rig.plot_rotation) << "pixel_format"
+            << std::string(core::toString(rig.pixel_format));
   } catch (const cv::Exception& e) {
     return Error{file.string() + ": cannot write: " + e.what()};
   }

@@ -4,9 +4,9 @@
 
 namespace fieldrig::pipeline {
 
-core::Result<PlotProcessor> PlotProcessor::create(const cloud::RigConfig& rig,
+core::Result<PlotProcessor> PlotProcessor::create(const cloud::RigCalibration& rig,
                                                   ProcessorOptions options) {
-  auto builder = cloud::CloudBuilder::create(rig, options.matcher);
+  auto builder = cloud::CloudBuilder::create(rig, options.cloud);
   if (!builder)
     return builder.error();
   return PlotProcessor(std::move(*builder), std::move(options));

@@ -1,4 +1,5 @@
 #include <array>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -10,27 +11,29 @@
 #include "fieldrig/stereo/preprocess.h"
 
 namespace fieldrig::sim {
-namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
-constexpr double kFocalPx = 1350.0;
-constexpr double kBaselineM = 0.12;
-constexpr std::array<double, 3> kHeadHeightM{0.55, 1.45, 2.35};
-const cv::Size kCameraSize(1624, 1224);
-
-}  // namespace
-
-cloud::RigConfig idealRig() {
+cloud::RigCalibration idealRig(const IdealRigGeometry& geometry) {
   const core::RigLayout layout;
-  cloud::RigConfig rig;
+  const cv::Size image_size(kIdealImageWidth, kIdealImageHeight);
+  cloud::RigCalibration rig;
   for (std::size_t i = 0; i < layout.heads.size(); ++i) {
-    cloud::HeadConfig head;
+    cloud::HeadCalibration head;
     head.name = layout.heads[i];
-    head.calibration = stereo::idealStereoCalibration(kFocalPx, kCameraSize, kBaselineM);
-    // Head frame → bottom head's frame: straight above it, and camera y points down.
-    head.to_bottom(1, 3) = -(kHeadHeightM[i] - kHeadHeightM[0]);
+    head.stereo = stereo::idealStereoCalibration(kIdealFocalPx, image_size, kIdealBaselineM);
+    // Head frame → bottom head's frame: straight above it (camera y points down), its z axis
+    // turned towards +y (down) by the tilt.
+    const double height = i < geometry.head_heights_m.size() ? geometry.head_heights_m[i] : 0;
+    const double tilt_deg =
+        i < geometry.head_tilts_down_deg.size() ? geometry.head_tilts_down_deg[i] : 0;
+    const double tilt = tilt_deg * CV_PI / 180.0;
+    head.to_bottom(1, 3) = -(height - geometry.head_heights_m.front());
+    head.to_bottom(1, 1) = std::cos(tilt);
+    head.to_bottom(1, 2) = std::sin(tilt);
+    head.to_bottom(2, 1) = -std::sin(tilt);
+    head.to_bottom(2, 2) = std::cos(tilt);
     rig.heads.push_back(std::move(head));
   }
   rig.pixel_format = core::PixelFormat::kBayerRG8;
@@ -56,9 +59,9 @@ core::Result<std::vector<RecordedPlot>> recordSyntheticPlots(
     const fs::path& session_dir, const fs::path& calib_dir, const PlotSeries& series,
     const std::vector<std::string>& locations,
     const std::function<void(const RecordedPlot&)>& progress) {
-  const cloud::RigConfig rig = idealRig();
+  const cloud::RigCalibration rig = idealRig();
   const core::RigLayout layout;
-  if (auto saved = cloud::saveRig(rig, calib_dir); !saved)
+  if (auto saved = cloud::saveRigCalibration(rig, calib_dir); !saved)
     return saved.error();
   recording::SessionInfo info;
   info.configuration = {{"source", "fieldrig synthetic plots"},
@@ -78,6 +81,7 @@ core::Result<std::vector<RecordedPlot>> recordSyntheticPlots(
   std::ofstream truth_file(truth_path);
   const core::UtcTime start = core::UtcTime{} + std::chrono::hours{24 * 20600};
 
+  const IdealRigGeometry geometry;  // the rig saved above
   std::vector<RecordedPlot> recorded;
   for (int index = 0; index < static_cast<int>(locations.size()); ++index) {
     RecordedPlot plot_info;
@@ -88,10 +92,10 @@ core::Result<std::vector<RecordedPlot>> recordSyntheticPlots(
     for (std::size_t head = 0; head < layout.heads.size(); ++head) {
       for (int side = 0; side < 2; ++side) {
         PinholeView view;
-        view.focal_px = kFocalPx;
-        view.size = kCameraSize;
+        view.focal_px = kIdealFocalPx;
+        view.size = cv::Size(kIdealImageWidth, kIdealImageHeight);
         // The right camera sits one baseline along the left camera's x, which is the row (+y).
-        view.position = Eigen::Vector3d(kHeadHeightM[head], side * kBaselineM, 0.0);
+        view.position = Eigen::Vector3d(geometry.head_heights_m[head], side * kIdealBaselineM, 0.0);
         raw[2 * head + static_cast<std::size_t>(side)] =
             stereo::mosaicBayer(renderPlotView(plot, view), core::PixelFormat::kBayerRG8);
       }

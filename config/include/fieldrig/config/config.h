@@ -19,7 +19,8 @@
 //               options {driver-specific key: value, given to every camera}
 //   calibration: the calibration folder (rig.yml + one folder per head)
 //   recording:  dir, fsync (none|per_set|per_frame)
-//   pipeline:   enabled, queue_sets, matcher {…MatcherOptions; mode sgbm|hh|sgbm_3way|hh4},
+//   pipeline:   enabled, queue_sets, cloud {scale, min_depth_m, max_depth_m, edge_max_jump_px},
+//               matcher {…MatcherOptions; mode sgbm|hh|sgbm_3way|hh4},
 //               traits {…TraitsOptions; outlier_method statistical|voxel_neighbours,
 //               area_method depth_map|paper|none, camera_to_plot [[3 numbers] × 3]}
 //   outputs:    dir (default RECORDING_DIR/results), csv, geojson, jsonl
@@ -35,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "fieldrig/cloud/cloud_options.h"
 #include "fieldrig/core/result.h"
 #include "fieldrig/core/rig_layout.h"
 #include "fieldrig/drivers/rig.h"
@@ -42,7 +44,6 @@
 #include "fieldrig/gps/trigger_planner.h"
 #include "fieldrig/recording/session_format.h"
 #include "fieldrig/recording/session_writer.h"
-#include "fieldrig/stereo/matcher.h"
 #include "fieldrig/traits/plot_traits.h"
 
 namespace fieldrig::config {
@@ -65,7 +66,7 @@ struct RecordingConfig {
 struct PipelineConfig {
   bool enabled = true;         // live processing of the recorded sets
   std::size_t queue_sets = 2;  // sets waiting for processing; more are skipped (and counted)
-  stereo::MatcherOptions matcher;
+  cloud::CloudOptions cloud;   // with its matcher (the file's pipeline.matcher)
   traits::TraitsOptions traits;
 };
 

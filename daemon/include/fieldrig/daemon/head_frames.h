@@ -20,14 +20,14 @@ namespace fieldrig::daemon {
 
 // The frames of recorded set `set_index`; only a set that does not exist is an error.
 core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
-    const recording::SessionReader& reader, std::uint64_t set_index, const cloud::RigConfig& rig,
-    std::vector<std::string>& problems);
+    const recording::SessionReader& reader, std::uint64_t set_index,
+    const cloud::RigCalibration& rig, std::vector<std::string>& problems);
 
 // The frames of a live set whose camera c is named camera_names[c]. The images point into the
 // set's pool buffers (no copy): keep the set alive while they are used.
 std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,
                                                       const std::vector<std::string>& camera_names,
-                                                      const cloud::RigConfig& rig,
+                                                      const cloud::RigCalibration& rig,
                                                       std::vector<std::string>& problems);
 
 // `explicit_dir` when given, else the session's calibration reference named "calib_dir"
@@ -37,7 +37,7 @@ std::optional<std::filesystem::path> sessionCalibrationDir(const std::string& ex
 
 // The rig of `explicit_dir`, else of the session's calib_dir reference (`reader` may be null when
 // the frames come from image files). The error says what to give, or names the file and field.
-core::Result<cloud::RigConfig> loadRigFor(const std::string& explicit_dir,
-                                          const recording::SessionReader* reader);
+core::Result<cloud::RigCalibration> loadRigFor(const std::string& explicit_dir,
+                                               const recording::SessionReader* reader);
 
 }  // namespace fieldrig::daemon

@@ -12,7 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "fieldrig/cloud/rig.h"
+#include "fieldrig/cloud/cloud_options.h"
+#include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/core/result.h"
 #include "fieldrig/stereo/head.h"
 
@@ -58,20 +59,20 @@ std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump);
 // Thread contract: thread-compatible; one instance per thread.
 class CloudBuilder {
  public:
-  // Builds each head's pipeline (maps, matchers) once. `matcher` overrides the disparity count
-  // with the rig's num_disparities.
-  static core::Result<CloudBuilder> create(const RigConfig& rig,
-                                           stereo::MatcherOptions matcher = {});
+  // Builds each head's pipeline (maps, matchers) once. The error names a bad option or head.
+  static core::Result<CloudBuilder> create(const RigCalibration& rig, CloudOptions options = {});
 
   // `frames` in the order of rig.heads. Never fails for bad frames: the head is flagged.
   // parallel_heads runs the heads on OpenCV's thread pool at once (each head's SGBM then runs
   // single-threaded inside it, as OpenCV does not nest parallel loops).
   FusionResult build(const std::vector<HeadFrames>& frames, bool parallel_heads = false);
 
-  const RigConfig& rig() const { return rig_; }
+  const RigCalibration& rig() const { return rig_; }
+  const CloudOptions& options() const { return options_; }
 
  private:
-  RigConfig rig_;
+  RigCalibration rig_;
+  CloudOptions options_;
   std::vector<stereo::HeadPipeline> heads_;
   std::vector<cv::Matx44d> to_plot_;  // head frame → plot frame
 };

@@ -12,13 +12,12 @@
 
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/core/result.h"
-#include "fieldrig/stereo/matcher.h"
 #include "fieldrig/traits/plot_traits.h"
 
 namespace fieldrig::pipeline {
 
 struct ProcessorOptions {
-  stereo::MatcherOptions matcher;  // its disparity count is taken from the rig's calibration
+  cloud::CloudOptions cloud;
   traits::TraitsOptions traits;
   bool keep_cloud = false;  // hand back the fused cloud (for `--clouds`); it costs a copy
 };
@@ -36,7 +35,7 @@ struct PlotResult {
 class PlotProcessor {
  public:
   // Builds each head's rectification maps and matcher once.
-  static core::Result<PlotProcessor> create(const cloud::RigConfig& rig,
+  static core::Result<PlotProcessor> create(const cloud::RigCalibration& rig,
                                             ProcessorOptions options = {});
 
   // `heads` in the order of rig().heads (an empty image marks a missing camera); `problems` are
@@ -44,7 +43,7 @@ class PlotProcessor {
   PlotResult process(const std::vector<cloud::HeadFrames>& heads,
                      std::vector<std::string> problems = {});
 
-  const cloud::RigConfig& rig() const { return builder_.rig(); }
+  const cloud::RigCalibration& rig() const { return builder_.rig(); }
   const ProcessorOptions& options() const { return options_; }
 
  private:

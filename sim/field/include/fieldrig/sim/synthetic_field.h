@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "fieldrig/cloud/rig.h"
+#include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/core/result.h"
 #include "fieldrig/core/rig_layout.h"
 #include "fieldrig/gps/trigger_planner.h"
@@ -26,8 +26,21 @@
 
 namespace fieldrig::sim {
 
+// The ideal heads' optics: Grasshopper-like cameras, distortion-free.
+inline constexpr double kIdealFocalPx = 1350.0;
+inline constexpr double kIdealBaselineM = 0.12;
+inline constexpr int kIdealImageWidth = 1624;
+inline constexpr int kIdealImageHeight = 1224;
+
+// Where the ideal rig's heads sit (bottom, middle, top): height above the soil, and the tilt of
+// each head down towards the soil about its camera x axis. The default is the tractor's rig.
+struct IdealRigGeometry {
+  std::vector<double> head_heights_m{0.55, 1.45, 2.35};
+  std::vector<double> head_tilts_down_deg{0, 0, 0};
+};
+
 // The ideal rig's calibration (rig.yml and the heads' files, as `fieldrig calibrate` writes them).
-cloud::RigConfig idealRig();
+cloud::RigCalibration idealRig(const IdealRigGeometry& geometry = {});
 
 // The plots' heights run linearly from height_min_m to height_max_m over the plots; every third
 // plot misses a plant, every third (offset by one) has an abnormally tall one.

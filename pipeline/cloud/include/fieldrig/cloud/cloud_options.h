@@ -1,0 +1,29 @@
+// How a set of head images becomes a cloud: the matching resolution, the matcher, the depth crop
+// and the depth-edge filter. Processing choices, set in the configuration (pipeline.cloud and
+// pipeline.matcher); the rig's geometry is cloud::RigCalibration.
+#pragma once
+
+#include <string>
+
+#include "fieldrig/core/result.h"
+#include "fieldrig/stereo/matcher.h"
+
+namespace fieldrig::cloud {
+
+struct CloudOptions {
+  double scale = 0.5;  // matching resolution / camera resolution, in (0, 1]
+  // The disparity search range at matching resolution is matcher.[min_disparity, min + num).
+  // With f ≈ 675 px and B = 0.12 m at 812×612, 0.8–1.7 m plants are 101–48 px.
+  stereo::MatcherOptions matcher;
+  double max_depth_m = 1.7;  // plot-frame z beyond this is a background row: cropped
+  double min_depth_m = 0.2;  // closer than this is not a plant (mismatches near the lens)
+  // Pixels on a depth edge — whose 3×3 neighbourhood spans more than this many pixels of
+  // disparity — are not reprojected: SGBM blends foreground and background there, and the
+  // blend lands as "flying" points between a leaf and what is behind it. 0 keeps them.
+  double edge_max_jump_px = 2.0;
+};
+
+// Why `options` cannot be used (naming the field), or nothing.
+core::Result<void> validate(const CloudOptions& options);
+
+}  // namespace fieldrig::cloud
