@@ -1,5 +1,5 @@
 # The sim camera driver (sim/camera): one test per frame source, fault injection, the driver and
-# its README's example configuration.
+# its README's example configuration, and replay of recorded sessions end to end.
 fieldrig_add_test(test_pattern_source_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_pattern_source_test.cpp
   LIBS fieldrig::sim_camera LABELS sim)
@@ -12,3 +12,9 @@ fieldrig_add_test(fault_injector_test
 fieldrig_add_test(sim_camera_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/sim_camera_test.cpp
   LIBS fieldrig::sim_camera fieldrig::config LABELS sim)
+# Records with the generated sim rig (daemon::Acquisition, and the CLI), replays with session=DIR.
+fieldrig_add_test(sim_replay_test
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/sim_replay_test.cpp
+  LIBS fieldrig::sim_camera fieldrig::recording fieldrig::daemon nlohmann_json::nlohmann_json
+  LABELS sim)
+add_dependencies(sim_replay_test fieldrig)  # its CLI test runs the built binary
