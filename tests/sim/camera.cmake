@@ -1,17 +1,11 @@
-# The sim camera driver (sim/camera): one test per frame source, fault injection, the driver and
-# its README's example configuration, and replay of recorded sessions end to end.
-fieldrig_add_test(test_pattern_source_test
-  SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_pattern_source_test.cpp
-  LIBS fieldrig::sim_camera LABELS sim)
-fieldrig_add_test(session_replay_source_test
-  SOURCES ${CMAKE_CURRENT_LIST_DIR}/session_replay_source_test.cpp
-  LIBS fieldrig::sim_camera fieldrig::recording LABELS sim)
-fieldrig_add_test(fault_injector_test
-  SOURCES ${CMAKE_CURRENT_LIST_DIR}/fault_injector_test.cpp
-  LIBS fieldrig::sim_camera LABELS sim)
+# The sim camera driver (sim/camera): one test file per class (the frame sources, fault
+# injection, the driver and its README's example configuration).
 fieldrig_add_test(sim_camera_test
-  SOURCES ${CMAKE_CURRENT_LIST_DIR}/sim_camera_test.cpp
-  LIBS fieldrig::sim_camera fieldrig::config LABELS sim)
+  SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_pattern_source_test.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/session_replay_source_test.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/fault_injector_test.cpp
+          ${CMAKE_CURRENT_LIST_DIR}/sim_camera_test.cpp
+  LIBS fieldrig::sim_camera fieldrig::recording fieldrig::config LABELS sim)
 # Records with the generated sim rig (daemon::Acquisition, and the CLI), replays with session=DIR.
 fieldrig_add_test(sim_replay_test
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/sim_replay_test.cpp

@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <thread>
+#include <vector>
 
 #include "fieldrig/sim/test_pattern_source.h"
 
@@ -30,6 +32,17 @@ core::Frame frameFor(const SimTrigger& trigger) {
   return stampedFrame(trigger, 2, kWidth, kHeight, core::PixelFormat::kMono8);
 }
 
+// The frame of one trigger through the pattern with `faults`, its buffer from `pool`; nullopt
+// when nothing is delivered.
+std::optional<core::Frame> fillOne(const FaultOptions& faults, const SimTrigger& trigger,
+                                   core::FramePool& pool) {
+  FaultInjector source = patternWith(faults);
+  core::Frame frame = frameFor(trigger);
+  if (!source.fill(trigger, pool, frame))
+    return std::nullopt;
+  return frame;
+}
+
 bool isPattern(const core::Frame& frame) {
   const std::uint8_t* pixels = frame.buffer.bytes().data();
   for (std::uint32_t y = 0; y < kHeight; ++y) {
@@ -43,15 +56,12 @@ bool isPattern(const core::Frame& frame) {
 }
 
 TEST(FaultInjectorTest, WithoutFaultsTheSourcesFrameComesThroughAsItIs) {
-  FaultInjector source = patternWith({});
   core::FramePool pool(1, std::size_t{kWidth} * kHeight);
-  const SimTrigger trigger = triggerNumber(6);
-  core::Frame frame = frameFor(trigger);
-  ASSERT_TRUE(source.fill(trigger, pool, frame));
-  ASSERT_TRUE(frame.buffer);
-  EXPECT_EQ(frame.metadata.status, core::FrameStatus::kOk);
-  EXPECT_EQ(frame.metadata.device_timestamp_ns, 1'000'000'000);
-  EXPECT_TRUE(isPattern(frame));
+  const auto frame = fillOne({}, triggerNumber(6), pool);
+  ASSERT_TRUE(frame && frame->buffer);
+  EXPECT_EQ(frame->metadata.status, core::FrameStatus::kOk);
+  EXPECT_EQ(frame->metadata.device_timestamp_ns, 1'000'000'000);
+  EXPECT_TRUE(isPattern(*frame));
 }
 
 TEST(FaultInjectorTest, DropEveryNDeliversNothingForIdsDivisibleByNAndTakesNoBuffer) {
@@ -92,41 +102,37 @@ TEST(FaultInjectorTest, CorruptEveryNMarksThoseFramesAndKeepsTheirPixels) {
 TEST(FaultInjectorTest, AFrameDroppedForWantOfABufferStaysDroppedNotCorrupt) {
   FaultOptions faults;
   faults.corrupt_every = 1;
-  FaultInjector source = patternWith(faults);
   core::FramePool pool(1, std::size_t{kWidth} * kHeight);
   const core::FrameBuffer held = pool.acquire();
-  core::Frame frame = frameFor(triggerNumber(5));
-  ASSERT_TRUE(source.fill(triggerNumber(5), pool, frame));
-  EXPECT_FALSE(frame.buffer);
-  EXPECT_EQ(frame.metadata.status, core::FrameStatus::kDropped);
+  const auto frame = fillOne(faults, triggerNumber(5), pool);
+  ASSERT_TRUE(frame);
+  EXPECT_FALSE(frame->buffer);
+  EXPECT_EQ(frame->metadata.status, core::FrameStatus::kDropped);
 }
 
 TEST(FaultInjectorTest, ClockOffsetShiftsTheDeviceTimestampExactly) {
   FaultOptions faults;
   faults.clock_offset = 250us;
-  FaultInjector source = patternWith(faults);
   core::FramePool pool(1, std::size_t{kWidth} * kHeight);
-  core::Frame frame = frameFor(triggerNumber(1));
-  ASSERT_TRUE(source.fill(triggerNumber(1), pool, frame));
-  EXPECT_EQ(frame.metadata.device_timestamp_ns, 1'000'000'000 + 250'000);
-  EXPECT_EQ(frame.metadata.status, core::FrameStatus::kOk);
+  const auto frame = fillOne(faults, triggerNumber(1), pool);
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(frame->metadata.device_timestamp_ns, 1'000'000'000 + 250'000);
+  EXPECT_EQ(frame->metadata.status, core::FrameStatus::kOk);
 }
 
 TEST(FaultInjectorTest, DelayHoldsTheFrameUntilItsTriggerPlusTheDelay) {
   FaultOptions faults;
   faults.delay = 30ms;
-  FaultInjector source = patternWith(faults);
   core::FramePool pool(1, std::size_t{kWidth} * kHeight);
   const core::SteadyTime issued = std::chrono::steady_clock::now();
-  const SimTrigger trigger = triggerNumber(1, issued);
-  core::Frame frame = frameFor(trigger);
-  ASSERT_TRUE(source.fill(trigger, pool, frame));
+  const auto frame = fillOne(faults, triggerNumber(1, issued), pool);
   EXPECT_GE(std::chrono::steady_clock::now(), issued + 30ms);
-  EXPECT_TRUE(isPattern(frame));
+  ASSERT_TRUE(frame);
+  EXPECT_TRUE(isPattern(*frame));
   // The delay counts from the trigger, not from the call: the device timestamp is still the
   // trigger instant.
   EXPECT_EQ(
-      frame.metadata.device_timestamp_ns,
+      frame->metadata.device_timestamp_ns,
       std::chrono::duration_cast<std::chrono::nanoseconds>(issued.time_since_epoch()).count());
 }
 

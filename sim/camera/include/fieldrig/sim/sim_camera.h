@@ -55,7 +55,7 @@ class SimCamera final : public drivers::Camera {
   core::SpscQueue<PendingTrigger> triggers_{256};
   std::atomic<std::uint32_t> wakeups_{0};  // bumped per trigger; the worker waits on it
   std::atomic<bool> running_{false};
-  std::uint64_t sequence_ = 0;                     // worker thread only
+  std::uint64_t sequence_ = 0;                     // frames delivered; worker thread only
   std::optional<std::uint64_t> first_trigger_id_;  // worker thread only; reset by start()
   std::thread worker_;
 };
