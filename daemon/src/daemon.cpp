@@ -37,6 +37,7 @@
 #include "fieldrig/gps/serial_nmea_source.h"
 #include "fieldrig/gps/trigger_replay.h"
 #include "fieldrig/pipeline/plot_processor.h"
+#include "fieldrig/sim/sim_camera.h"
 #include "nmea_player.h"
 #include "service_notifier.h"
 
@@ -258,6 +259,7 @@ class Daemon {
                        .dump()
                 << std::endl;
     }
+    sim::addSimCamera(drivers::CameraRegistry::instance());  // drivers/ knows nothing of sim/
     auto created = Acquisition::create(acquisition, drivers::CameraRegistry::instance());
     if (!created) {
       spdlog::error("{}", created.error().message);

@@ -1,7 +1,5 @@
 #include "fieldrig/drivers/camera.h"
 
-#include "fieldrig/drivers/sim_camera.h"
-
 #ifdef FIELDRIG_HAVE_DC1394
 #include "fieldrig/drivers/dc1394/dc1394_camera.h"
 #endif
@@ -13,10 +11,10 @@ namespace fieldrig::drivers {
 
 CameraRegistry& CameraRegistry::instance() {
   // Built-in drivers are added here rather than by static registrars in their own files: a
-  // static library drops object files nothing refers to, registrars included.
+  // static library drops object files nothing refers to, registrars included. The sim driver
+  // is not built in: drivers/ knows nothing of sim/, whose users add it (sim::addSimCamera).
   static CameraRegistry registry = [] {
     CameraRegistry r;
-    r.add("sim", [] { return std::make_unique<SimCamera>(); });
 #ifdef FIELDRIG_HAVE_DC1394
     r.add("dc1394", [] { return makeDc1394Camera(); });
 #endif

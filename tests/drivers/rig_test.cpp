@@ -7,8 +7,9 @@
 #include <mutex>
 #include <thread>
 
-#include "fieldrig/drivers/sim_camera.h"
+#include "fieldrig/sim/test_pattern_source.h"
 #include "support/frame_set_collector.h"
+#include "support/sim_cameras.h"
 
 namespace fieldrig::drivers {
 namespace {
@@ -35,7 +36,8 @@ bool patternMatches(const core::Frame& frame) {
   const std::uint8_t* pixels = frame.buffer.bytes().data();
   for (std::uint32_t y = 0; y < m.height; y += 7) {
     for (std::uint32_t x = 0; x < m.width; x += 5) {
-      if (pixels[y * m.stride + x] != SimCamera::patternAt(m.camera, m.trigger_id, x, y)) {
+      if (pixels[y * m.stride + x] !=
+          sim::TestPatternSource::patternAt(m.camera, m.trigger_id, x, y)) {
         return false;
       }
     }
@@ -46,7 +48,7 @@ bool patternMatches(const core::Frame& frame) {
 TEST(RigTest, OneWholeSetPerTriggerInOrder) {
   RigOptions options = sixCameras();
   options.pool_sets = 64;  // this test's collector keeps every set (and its buffers) to the end
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok()) << rig.error().message;
   Collector collector;
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());
@@ -79,7 +81,7 @@ TEST(RigTest, OneWholeSetPerTriggerInOrder) {
 TEST(RigTest, MissingFrameYieldsAnIncompleteSetAfterTheTimeoutWithoutReordering) {
   RigOptions options = sixCameras();
   options.cameras[3].options["drop_every"] = "5";
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok()) << rig.error().message;
   Collector collector;
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());
@@ -106,7 +108,7 @@ TEST(RigTest, MissingFrameYieldsAnIncompleteSetAfterTheTimeoutWithoutReordering)
 TEST(RigTest, SkewAboveTheToleranceIsFlagged) {
   RigOptions options = sixCameras();
   options.cameras[5].options["clock_offset_us"] = "300";
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok()) << rig.error().message;
   Collector collector;
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());
@@ -125,7 +127,7 @@ TEST(RigTest, SkewAboveTheToleranceIsFlagged) {
 TEST(RigTest, CorruptFramesAreDeliveredMarked) {
   RigOptions options = sixCameras();
   options.cameras[0].options["corrupt_every"] = "2";
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok());
   Collector collector;
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());
@@ -146,7 +148,7 @@ TEST(RigTest, BuffersReturnToThePoolWhenConsumersLetGo) {
   // Every frame must arrive for the count below: a sim worker starved for 100 ms on a loaded
   // 2-core machine (the test suite runs in parallel) would time its frame out as missing.
   options.frame_timeout = 2s;
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok());
   Collector collector;
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());
@@ -163,7 +165,7 @@ TEST(RigTest, BuffersReturnToThePoolWhenConsumersLetGo) {
 TEST(RigTest, BuffersReturnEvenWhenTheSinkCopiesTheSet) {
   RigOptions options = sixCameras();
   options.pool_sets = 4;  // fewer buffers than triggers: they must come back to be reused
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok());
   std::atomic<int> complete{0};
   ASSERT_TRUE((*rig)
@@ -189,7 +191,7 @@ TEST(RigTest, BuffersReturnEvenWhenTheSinkCopiesTheSet) {
 TEST(RigTest, ExhaustedPoolShowsAsDroppedFrames) {
   RigOptions options = sixCameras();
   options.pool_sets = 2;  // 12 buffers
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok());
   Collector collector;  // keeps every set: nothing returns to the pool
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());
@@ -213,12 +215,12 @@ TEST(RigTest, ExhaustedPoolShowsAsDroppedFrames) {
 TEST(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
   RigOptions options = sixCameras();
   options.cameras[4].id = "left";
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_FALSE(rig.ok());
   EXPECT_NE(rig.error().message.find("rig camera 4"), std::string::npos) << rig.error().message;
   options = sixCameras();
   options.driver = "gige";
-  rig = Rig::create(options, CameraRegistry::instance());
+  rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_FALSE(rig.ok());
   EXPECT_NE(rig.error().message.find("unknown camera driver 'gige'"), std::string::npos);
   EXPECT_NE(rig.error().message.find("sim"), std::string::npos);
@@ -235,7 +237,7 @@ TEST(RigTest, TooManyWaitingSetsLeaveOldestFirstIncomplete) {
   options.cameras[1].options["drop_every"] = "1";    // camera 1 never delivers
   options.frame_timeout = std::chrono::seconds{30};  // so only the ring's size lets sets go
   options.pool_sets = 300;
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok()) << rig.error().message;
   std::vector<std::uint64_t> order;
   std::mutex mutex;
@@ -276,7 +278,7 @@ TEST(RigTest, FramesArrivingShuffledAcrossTriggersAreGroupedRight) {
   for (int c = 0; c < 6; ++c)
     options.cameras[c].options["delay_ms"] = std::to_string(delays_ms[c]);
   options.pool_sets = 64;
-  auto rig = Rig::create(options, CameraRegistry::instance());
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok()) << rig.error().message;
   Collector collector;
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());

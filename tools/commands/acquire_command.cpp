@@ -11,6 +11,7 @@
 #include "commands/commands.h"
 #include "fieldrig/daemon/acquisition.h"
 #include "fieldrig/recording/session_format.h"
+#include "fieldrig/sim/sim_camera.h"
 
 namespace fieldrig::tools {
 namespace {
@@ -100,6 +101,7 @@ int runAcquire(const AcquireArgs& args) {
                                    {"rate_hz", args.rate_hz},
                                    {"fsync", args.fsync}};
 
+  sim::addSimCamera(drivers::CameraRegistry::instance());  // drivers/ knows nothing of sim/
   auto acquisition = daemon::Acquisition::create(options, drivers::CameraRegistry::instance());
   if (!acquisition) {
     std::cerr << kName << acquisition.error().message << '\n';

@@ -59,7 +59,8 @@ class CameraRegistry {
  public:
   using Factory = std::function<std::unique_ptr<Camera>()>;
 
-  // The registry with every driver this build has.
+  // The registry with every hardware driver this build has. Other drivers are added by their
+  // users, before they create cameras: the sim driver by sim::addSimCamera.
   static CameraRegistry& instance();
 
   void add(const std::string& name, Factory factory);

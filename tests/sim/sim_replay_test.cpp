@@ -13,16 +13,21 @@
 
 #include "fieldrig/daemon/acquisition.h"
 #include "fieldrig/drivers/rig.h"
-#include "fieldrig/drivers/sim_camera.h"
 #include "fieldrig/recording/session_reader.h"
+#include "fieldrig/sim/sim_camera.h"
 #include "support/cli_run.h"
 #include "support/frame_set_collector.h"
+#include "support/sim_cameras.h"
 #include "support/temp_dir.h"
 
-namespace fieldrig::drivers {
+namespace fieldrig::sim {
 namespace {
 
 using namespace std::chrono_literals;
+using drivers::CameraConfig;
+using drivers::Rig;
+using drivers::RigOptions;
+using drivers::RigStats;
 using testing_support::ScopedTempDir;
 
 constexpr std::uint32_t kWidth = 64;
@@ -48,7 +53,7 @@ std::filesystem::path recordSession(const std::filesystem::path& dir) {
   options.rig.frame_timeout = 100ms;
   options.session_dir = dir / "recorded";
   options.writer.fsync = recording::FsyncPolicy::kNone;
-  auto acquisition = daemon::Acquisition::create(options, CameraRegistry::instance());
+  auto acquisition = daemon::Acquisition::create(options, testing_support::camerasWithSim());
   EXPECT_TRUE(acquisition.ok()) << acquisition.error().message;
   if (!acquisition)
     return options.session_dir;
@@ -102,7 +107,7 @@ void replayAndCompare(const std::filesystem::path& session,
   ASSERT_EQ(missing, 3u);  // camera 2, triggers 4, 8, 12
   ASSERT_EQ(corrupt, 2u);  // camera 1, triggers 5, 10
 
-  auto rig = Rig::create(replayingRig(session, extra), CameraRegistry::instance());
+  auto rig = Rig::create(replayingRig(session, extra), testing_support::camerasWithSim());
   ASSERT_TRUE(rig.ok()) << rig.error().message;
   Collector collector;
   ASSERT_TRUE((*rig)->start(collector.sink()).ok());
@@ -170,7 +175,7 @@ TEST(SimReplayTest, ReplaysTheRecordingSetBySetReadingFramesPerTrigger) {
 TEST(SimReplayTest, ABadSessionPathIsAnErrorNamingIt) {
   const ScopedTempDir dir("sim_replay_bad_path");
   const auto missing = dir.path() / "no_such_session";
-  const auto rig = Rig::create(replayingRig(missing), CameraRegistry::instance());
+  const auto rig = Rig::create(replayingRig(missing), testing_support::camerasWithSim());
   ASSERT_FALSE(rig.ok());
   EXPECT_NE(rig.error().message.find(missing.string()), std::string::npos) << rig.error().message;
 }
@@ -251,4 +256,4 @@ TEST(SimReplayCliTest, AcquireReplaysARecordedSessionIntoAnIdenticalOne) {
 }
 
 }  // namespace
-}  // namespace fieldrig::drivers
+}  // namespace fieldrig::sim
