@@ -19,9 +19,12 @@ int main(int argc, char** argv) {
   fieldrig::tools::registerSimCommand(app, exit_code);
   fieldrig::tools::registerAcquireCommand(app, exit_code);
   fieldrig::tools::registerSessionCommand(app, exit_code);
-  fieldrig::tools::registerStereoCommands(app, exit_code);
+  fieldrig::tools::registerCalibrateCommand(app, exit_code);
+  fieldrig::tools::registerDisparityCommand(app, exit_code);
+  fieldrig::tools::registerCloudCommand(app, exit_code);
   fieldrig::tools::registerTraitsCommand(app, exit_code);
-  fieldrig::tools::registerStemCommands(app, exit_code);
+  fieldrig::tools::registerStemCommand(app, exit_code);
+  fieldrig::tools::registerStemUiCommand(app, exit_code);
   fieldrig::tools::registerProcessCommand(app, exit_code);
   fieldrig::tools::registerSimulateCommand(app, exit_code);
   CLI11_PARSE(app, argc, argv);

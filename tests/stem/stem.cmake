@@ -6,6 +6,12 @@ fieldrig_add_test(stem_log_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/stem_log_test.
 fieldrig_add_test(stem_measure_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/stem_measure_test.cpp
                   LIBS fieldrig::stem fieldrig::sim_render LABELS stem)
 
+# The stem page (tools/stem_page): its route table, and its API on a recorded session, without a
+# server.
+fieldrig_add_test(stem_page_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/stem_page_routes_test.cpp
+                                         ${CMAKE_CURRENT_LIST_DIR}/stem_page_test.cpp
+                  LIBS fieldrig::stem_page LABELS stem tools)
+
 # `fieldrig stem`: the command's contract, run as the built binary on rendered pairs.
 fieldrig_add_test(stem_cli_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/stem_cli_test.cpp
                   LIBS fieldrig::stem fieldrig::sim_render nlohmann_json::nlohmann_json

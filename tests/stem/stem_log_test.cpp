@@ -1,7 +1,8 @@
 // The CSV log of measurements: round trip (quoting included), repeat numbering, mean and SD of
-// repeats, and errors that name the file, line and field.
+// repeats, removing a session's last row, and errors that name the file, line and field.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 
 #include "fieldrig/stem/measurement_log.h"
@@ -67,6 +68,62 @@ TEST(StemLog, NumbersRepeatsPerStemAndSummarizesMeanAndSd) {
   EXPECT_DOUBLE_EQ(summary[0].sd_mm, 2.0);  // sample SD of 10, 12, 14
   EXPECT_EQ(summary[1].count, 1);
   EXPECT_DOUBLE_EQ(summary[1].sd_mm, 0.0);
+}
+
+TEST(StemLog, RemovingTheLastRowTakesOnlyThatSessionsLastRow) {
+  testing_support::ScopedTempDir dir("stem_log_remove_last");
+  const auto file = dir / "stem.csv";
+  auto in_session = [](const std::string& session, const std::string& label, double diameter,
+                       int repeat) {
+    MeasurementRecord r = record(label, diameter, repeat);
+    r.session = session;
+    return r;
+  };
+  ASSERT_TRUE(appendMeasurement(file, in_session("north", "a", 10.0, 1)).ok());
+  ASSERT_TRUE(appendMeasurement(file, in_session("south", "b", 20.0, 1)).ok());
+  ASSERT_TRUE(appendMeasurement(file, in_session("north", "a", 12.0, 2)).ok());
+  ASSERT_TRUE(appendMeasurement(file, in_session("south", "c", 30.0, 1)).ok());
+
+  auto removed = removeLastMeasurement(file, "north");
+  ASSERT_TRUE(removed.ok()) << removed.error().message;
+  ASSERT_TRUE(removed->has_value());
+  EXPECT_DOUBLE_EQ((*removed)->diameter_mm, 12.0);
+  EXPECT_EQ((*removed)->repeat, 2);
+  auto records = readMeasurementLog(file);
+  ASSERT_TRUE(records.ok()) << records.error().message;
+  ASSERT_EQ(records->size(), 3u);
+  EXPECT_DOUBLE_EQ((*records)[0].diameter_mm, 10.0);
+  EXPECT_DOUBLE_EQ((*records)[1].diameter_mm, 20.0);
+  EXPECT_DOUBLE_EQ((*records)[2].diameter_mm, 30.0);
+  std::ifstream in(file);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, csvHeader());
+  EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp")) << "the temporary file is left";
+
+  ASSERT_TRUE(removeLastMeasurement(file, "north")->has_value());
+  auto none = removeLastMeasurement(file, "north");
+  ASSERT_TRUE(none.ok()) << none.error().message;
+  EXPECT_FALSE(none->has_value());
+  EXPECT_EQ(readMeasurementLog(file)->size(), 2u) << "the other session's rows stay";
+
+  auto absent = removeLastMeasurement(dir / "absent.csv", "north");
+  ASSERT_TRUE(absent.ok()) << absent.error().message;
+  EXPECT_FALSE(absent->has_value());
+  EXPECT_FALSE(std::filesystem::exists(dir / "absent.csv"));
+}
+
+TEST(StemLog, AppendsToAFileNamedRelativeToTheWorkingFolder) {
+  testing_support::ScopedTempDir dir("stem_log_relative");
+  const std::filesystem::path before = std::filesystem::current_path();
+  std::filesystem::current_path(dir.path());
+  const auto appended = appendMeasurement("stem.csv", record("a", 10.0, 1));
+  const auto removed = removeLastMeasurement("stem.csv", record("a", 10.0, 1).session);
+  std::filesystem::current_path(before);
+  ASSERT_TRUE(appended.ok()) << appended.error().message;
+  ASSERT_TRUE(removed.ok()) << removed.error().message;
+  EXPECT_TRUE(removed->has_value());
+  EXPECT_TRUE(readMeasurementLog(dir / "stem.csv")->empty());
 }
 
 TEST(StemLog, AMissingFileIsAnEmptyLogAndABadFieldIsNamed) {

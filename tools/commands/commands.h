@@ -17,9 +17,12 @@ void registerTriggersCommand(CLI::App& app, int& exit_code);
 void registerSimCommand(CLI::App& app, int& exit_code);
 void registerAcquireCommand(CLI::App& app, int& exit_code);
 void registerSessionCommand(CLI::App& app, int& exit_code);
-void registerStereoCommands(CLI::App& app, int& exit_code);  // calibrate, disparity, cloud
+void registerCalibrateCommand(CLI::App& app, int& exit_code);
+void registerDisparityCommand(CLI::App& app, int& exit_code);
+void registerCloudCommand(CLI::App& app, int& exit_code);
 void registerTraitsCommand(CLI::App& app, int& exit_code);
-void registerStemCommands(CLI::App& app, int& exit_code);  // stem, stem-ui
+void registerStemCommand(CLI::App& app, int& exit_code);
+void registerStemUiCommand(CLI::App& app, int& exit_code);
 void registerProcessCommand(CLI::App& app, int& exit_code);
 // `sim plots`, added to the `sim` subcommand by registerSimCommand.
 void registerSimPlotsSubcommand(CLI::App& sim, int& exit_code);

@@ -1,11 +1,10 @@
 // `fieldrig process SESSION [--calib DIR] [--map MAP.csv] [--config FILE] [--traits-config FILE]
 //  [--out DIR] [--shard K/N] [--force] [--clouds]`: every FrameSet of a recorded session through
 //  the plot
-// processor (three heads → fused cloud → plot traits), the daemon's own, into the results folder
-// (plots.jsonl, plots.csv, plots.geojson; daemon/results_writer.h) and one JSON line per set on
-// stdout. It resumes: sets already in the folder's plots.jsonl (by trigger id) are skipped unless
-// --force. A set that cannot be processed is reported with its status and kept in the outputs;
-// it never stops the run.
+// processor, the daemon's own (daemon/session_processing.h), into the results folder (plots.jsonl,
+// plots.csv, plots.geojson; daemon/results_writer.h), one JSON line per set on stdout and a summary
+// line last. It resumes: sets already in the folder's plots.jsonl (by trigger id) are skipped
+// unless --force.
 #include <charconv>
 #include <filesystem>
 #include <iostream>
@@ -13,11 +12,10 @@
 #include <optional>
 
 #include "commands/commands.h"
-#include "fieldrig/cloud/fusion.h"
 #include "fieldrig/config/config.h"
-#include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/daemon/results_writer.h"
+#include "fieldrig/daemon/session_processing.h"
 #include "fieldrig/gps/location_map.h"
 #include "fieldrig/pipeline/plot_processor.h"
 #include "fieldrig/recording/session_reader.h"
@@ -34,39 +32,25 @@ struct ProcessArgs {
   bool force = false;
 };
 
-struct Shard {
-  std::size_t index = 0;  // 0 … count-1
-  std::size_t count = 1;
-};
-
-// "K/N" with 0 ≤ K < N: this run takes every N-th set starting at the K-th, so shards get the
-// same number of sets (±1) whatever the sessions' lengths.
-std::optional<Shard> parseShard(const std::string& text) {
+// "K/N" with 0 ≤ K < N into the run's shard.
+bool parseShard(const std::string& text, daemon::SessionProcessingOptions& run) {
   const auto slash = text.find('/');
   if (slash == std::string::npos)
-    return std::nullopt;
-  Shard shard;
+    return false;
   const char* begin = text.data();
   const char* end = begin + text.size();
-  const auto k = std::from_chars(begin, begin + slash, shard.index);
-  const auto n = std::from_chars(begin + slash + 1, end, shard.count);
-  if (k.ec != std::errc{} || k.ptr != begin + slash || n.ec != std::errc{} || n.ptr != end ||
-      shard.count == 0 || shard.index >= shard.count) {
-    return std::nullopt;
-  }
-  return shard;
+  const auto k = std::from_chars(begin, begin + slash, run.shard_index);
+  const auto n = std::from_chars(begin + slash + 1, end, run.shard_count);
+  return k.ec == std::errc{} && k.ptr == begin + slash && n.ec == std::errc{} && n.ptr == end &&
+         run.shard_count != 0 && run.shard_index < run.shard_count;
 }
 
 int runProcess(const ProcessArgs& args) {
   const char* who = "fieldrig process: ";
-  Shard shard;
-  if (!args.shard.empty()) {
-    const auto parsed = parseShard(args.shard);
-    if (!parsed) {
-      std::cerr << who << "--shard '" << args.shard << "': expected K/N with 0 <= K < N\n";
-      return kExitBadInput;
-    }
-    shard = *parsed;
+  daemon::SessionProcessingOptions run;
+  if (!args.shard.empty() && !parseShard(args.shard, run)) {
+    std::cerr << who << "--shard '" << args.shard << "': expected K/N with 0 <= K < N\n";
+    return kExitBadInput;
   }
   auto opened = recording::SessionReader::open(args.session);
   if (!opened) {
@@ -113,8 +97,9 @@ int runProcess(const ProcessArgs& args) {
     return kExitBadInput;
   }
   fs::path out_dir = args.out.empty() ? reader.dir() / "results" : fs::path(args.out);
-  if (args.out.empty() && shard.count > 1) {  // shards never write the same file
-    out_dir /= "shard-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count);
+  if (args.out.empty() && run.shard_count > 1) {  // shards never write the same file
+    out_dir /=
+        "shard-" + std::to_string(run.shard_index) + "-of-" + std::to_string(run.shard_count);
   }
   if (args.force) {
     std::error_code ec;
@@ -126,61 +111,22 @@ int runProcess(const ProcessArgs& args) {
     std::cerr << who << results.error().message << '\n';
     return kExitBadInput;
   }
-
-  std::size_t sets = 0, ok_sets = 0, partial_clouds = 0, unplaced = 0, skipped = 0;
-  for (std::size_t position = 0; position < reader.sets().size(); ++position) {
-    const recording::IndexedSet& set = reader.sets()[position];
-    if (position % shard.count != shard.index)
-      continue;
-    if ((*results)->contains(set.trigger_id)) {
-      ++skipped;
-      continue;
-    }
-    std::vector<std::string> problems;
-    auto frames = daemon::headFramesFromRecording(reader, set.set_index, *rig, problems);
-    pipeline::PlotResult result;
-    if (frames) {
-      result = processor->process(*frames, std::move(problems));
-    } else {
-      result.problems = std::move(problems);
-      result.problems.push_back(frames.error().message);
-      result.traits.status = traits::TraitsStatus::kEmptyCloud;
-      result.traits.message = frames.error().message;
-    }
-    daemon::PlotIdentity identity;
-    identity.set_index = set.set_index;
-    identity.trigger_id = set.trigger_id;
-    identity.location_id = set.location_id;
-    identity.time = core::formatIso8601(set.trigger_time, 6);
-    identity.position = daemon::plotPosition(set.location_id, set.fix, map ? &*map : nullptr);
-    identity.trigger_status = set.trigger_status.value_or("");
-    const Json line = daemon::plotLine(identity, result);
-    if (args.clouds && frames) {
-      const fs::path ply = out_dir / (line.at("plot").get<std::string>() + "_set" +
-                                      std::to_string(set.set_index) + ".ply");
-      if (auto written = cloud::writePly(result.cloud, ply); !written)
-        std::cerr << who << written.error().message << '\n';
-    }
-    ++sets;
-    ok_sets += result.traits.status == traits::TraitsStatus::kOk ? 1 : 0;
-    partial_clouds += result.partial ? 1 : 0;
-    unplaced += identity.position ? 0 : 1;
-    std::cout << line.dump() << std::endl;
-    if (const std::string failed = (*results)->add(line); !failed.empty()) {
-      std::cerr << who << failed << '\n';
-      return kExitRuntime;
-    }
-  }
-  if (const std::string failed = (*results)->flush(); !failed.empty()) {
-    std::cerr << who << failed << '\n';
+  if (args.clouds)
+    run.clouds_dir = out_dir;
+  auto done = daemon::processSession(
+      reader, *processor, map ? &*map : nullptr, **results, run,
+      [](const Json& line) { std::cout << line.dump() << std::endl; },
+      [who](const std::string& problem) { std::cerr << who << problem << '\n'; });
+  if (!done) {
+    std::cerr << who << done.error().message << '\n';
     return kExitRuntime;
   }
   Json summary;
-  summary["sets"] = sets;
-  summary["ok"] = ok_sets;
-  summary["partial_clouds"] = partial_clouds;
-  summary["unplaced"] = unplaced;
-  summary["already_done"] = skipped;
+  summary["sets"] = done->sets;
+  summary["ok"] = done->ok;
+  summary["partial_clouds"] = done->partial_clouds;
+  summary["unplaced"] = done->unplaced;
+  summary["already_done"] = done->already_done;
   summary["plots_in_results"] = (*results)->plots();
   summary["csv"] = (out_dir / "plots.csv").string();
   summary["geojson"] = (out_dir / "plots.geojson").string();

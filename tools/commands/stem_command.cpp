@@ -4,17 +4,22 @@
 // Points are pixels of the raw left image, any order. Exit codes: 0 measured; 2 bad input
 // (files, calibration, points that are not a convex quadrangle); 3 no reliable measurement
 // (weak NCC match, no disparity range in the image).
-// `fieldrig stem-ui` (the browser tool) is registered from stem_ui_server.cpp.
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include "commands/commands.h"
-#include "commands/stem_support.h"
+#include "fieldrig/core/pixel_format.h"
+#include "fieldrig/stem/measurement_json.h"
 #include "fieldrig/stem/stem_measurer.h"
+#include "fieldrig/stereo/preprocess.h"
 
 namespace fieldrig::tools {
 namespace {
@@ -25,6 +30,47 @@ struct StemArgs {
   bool face_value = false;
   bool plane = false;
 };
+
+// "x1,y1,…,x4,y4": eight finite numbers.
+core::Result<stem::Points4> parseStemPoints(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    errno = 0;
+    const double value = std::strtod(item.c_str(), &end);
+    if (item.empty() || errno != 0 || end != item.c_str() + item.size() || !std::isfinite(value))
+      return core::Error{"'" + item + "' is not a number"};
+    values.push_back(value);
+  }
+  if (values.size() != 8) {
+    return core::Error{"expected 8 numbers (x1,y1,…,x4,y4), got " + std::to_string(values.size())};
+  }
+  stem::Points4 points;
+  for (std::size_t i = 0; i < 4; ++i)
+    points[i] = cv::Point2d(values[2 * i], values[2 * i + 1]);
+  return points;
+}
+
+// An image file as 8-bit grey; `bayer` ("", "RG", "GR", "GB", "BG") demosaics raw Bayer.
+core::Result<cv::Mat> loadGreyImage(const std::filesystem::path& file, const std::string& bayer) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    return core::Error{file.string() + ": no such image file"};
+  cv::Mat image =
+      cv::imread(file.string(), bayer.empty() ? cv::IMREAD_GRAYSCALE : cv::IMREAD_UNCHANGED);
+  if (image.empty())
+    return core::Error{file.string() + ": not an image OpenCV can read"};
+  if (bayer.empty())
+    return image;
+  const std::optional<core::PixelFormat> format = core::parsePixelFormat("Bayer" + bayer + "8");
+  if (!format)
+    return core::Error{"--bayer: '" + bayer + "' is not one of RG, GR, GB, BG"};
+  if (image.type() != CV_8UC1)
+    return core::Error{file.string() + ": raw Bayer must be one 8-bit channel"};
+  return stereo::toGrey(image, *format);
+}
 
 int runStem(const StemArgs& args) {
   const auto fail = [](const std::string& message) {
@@ -53,7 +99,7 @@ int runStem(const StemArgs& args) {
   options.cylinder_model = !args.plane;
   const stem::StemMeasurement m = measurer->measure(*points, options);
   if (args.json) {
-    std::cout << measurementJson(m).dump() << '\n';
+    std::cout << stem::toJson(m).dump() << '\n';
   } else if (m.ok()) {
     std::cout << "diameter " << m.diameter_mm << " mm  (disparity " << m.disparity_px << " px, NCC "
               << m.ncc << ", width " << m.width.d << " px)\n";
@@ -66,7 +112,7 @@ int runStem(const StemArgs& args) {
 
 }  // namespace
 
-void registerStemCommands(CLI::App& app, int& exit_code) {
+void registerStemCommand(CLI::App& app, int& exit_code) {
   CLI::App* command = app.add_subcommand(
       "stem", "Stem diameter from four clicks on its edges in the raw left image of a stereo pair");
   auto args = std::make_shared<StemArgs>();
@@ -87,7 +133,6 @@ void registerStemCommands(CLI::App& app, int& exit_code) {
   command->add_flag("--plane", args->plane,
                     "Diameter by eq. 13 (fronto-parallel patch) instead of the cylinder model");
   command->callback([args, &exit_code] { exit_code = runStem(*args); });
-  registerStemUiCommand(app, exit_code);
 }
 
 }  // namespace fieldrig::tools

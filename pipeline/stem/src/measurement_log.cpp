@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "fieldrig/core/durable_file.h"
+
 namespace fieldrig::stem {
 namespace {
 
@@ -173,16 +175,38 @@ core::Result<bool> appendMeasurement(const std::filesystem::path& file,
   std::error_code ec;
   const bool fresh =
       !std::filesystem::exists(file, ec) || std::filesystem::file_size(file, ec) == 0;
-  std::ofstream out(file, std::ios::app);
-  if (!out)
-    return core::Error{file.string() + ": cannot be opened for writing"};
-  if (fresh)
-    out << csvHeader() << '\n';
-  out << toCsvRow(record) << '\n';
-  out.flush();
-  if (!out)
-    return core::Error{file.string() + ": write failed"};
+  // Header and row in one append: a crash cannot leave a header without its first row. (Built by
+  // appending: GCC 12 -O3 gives a false-positive -Wrestrict on string + string.)
+  std::string text = fresh ? csvHeader() + '\n' : std::string();
+  text.append(toCsvRow(record)).append(1, '\n');
+  // The durable helper syncs the file's folder, which must be named even for a bare file name.
+  if (std::string failed = core::appendDurably(std::filesystem::absolute(file), text);
+      !failed.empty())
+    return core::Error{std::move(failed)};
   return true;
+}
+
+core::Result<std::optional<MeasurementRecord>> removeLastMeasurement(
+    const std::filesystem::path& file, const std::string& session) {
+  core::Result<std::vector<MeasurementRecord>> records = readMeasurementLog(file);
+  if (!records)
+    return records.error();
+  std::optional<std::size_t> last;
+  for (std::size_t i = 0; i < records->size(); ++i) {
+    if ((*records)[i].session == session)
+      last = i;
+  }
+  if (!last)
+    return std::optional<MeasurementRecord>();
+  MeasurementRecord removed = std::move((*records)[*last]);
+  records->erase(records->begin() + static_cast<std::ptrdiff_t>(*last));
+  std::string text = csvHeader() + '\n';
+  for (const MeasurementRecord& r : *records)
+    text.append(toCsvRow(r)).append(1, '\n');
+  if (std::string failed = core::replaceFileAtomically(std::filesystem::absolute(file), text);
+      !failed.empty())
+    return core::Error{std::move(failed)};
+  return std::optional<MeasurementRecord>(std::move(removed));
 }
 
 int nextRepeat(const std::vector<MeasurementRecord>& records, const std::string& session,

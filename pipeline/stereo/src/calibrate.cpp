@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace fieldrig::stereo {
@@ -204,6 +205,74 @@ core::Result<cv::Matx44d> calibrateHeadToHead(
   const cv::Matx44d rect_a_from_camera_a = toMatx44(head_a.R1, cv::Mat::zeros(3, 1, CV_64F));
   const cv::Matx44d camera_b_from_rect_b = toMatx44(head_b.R1.t(), cv::Mat::zeros(3, 1, CV_64F));
   return rect_a_from_camera_a * camera_a_from_camera_b * camera_b_from_rect_b;
+}
+
+core::Result<BoardPairs> findBoardInImagePairs(const std::vector<std::string>& left,
+                                               const std::vector<std::string>& right,
+                                               const BoardSpec& board) {
+  BoardPairs found;
+  for (std::size_t i = 0; i < left.size() && i < right.size(); ++i) {
+    PairCorners pair;
+    pair.name = std::filesystem::path(left[i]).filename().string() + "/" +
+                std::filesystem::path(right[i]).filename().string();
+    for (const auto& [file, corners] :
+         {std::pair{&left[i], &pair.left}, std::pair{&right[i], &pair.right}}) {
+      const cv::Mat grey = cv::imread(*file, cv::IMREAD_GRAYSCALE);
+      if (grey.empty())
+        return core::Error{*file + ": cannot read the image"};
+      if (found.image_size.empty())
+        found.image_size = grey.size();
+      if (grey.size() != found.image_size) {
+        return core::Error{*file + ": image is " + std::to_string(grey.cols) + "x" +
+                           std::to_string(grey.rows) + ", the first was " +
+                           std::to_string(found.image_size.width) + "x" +
+                           std::to_string(found.image_size.height)};
+      }
+      if (auto corners_found = findBoardCorners(grey, board))
+        *corners = std::move(*corners_found);
+    }
+    if (!pair.found()) {  // a pair counts only when both images show the board
+      pair.left.clear();
+      pair.right.clear();
+    }
+    found.pairs.push_back(std::move(pair));
+  }
+  return found;
+}
+
+core::Result<HeadToHeadReport> calibrateHeadToHead(StereoCalibration head_a,
+                                                   const StereoCalibration& head_b,
+                                                   const BoardPairs& pairs,
+                                                   const BoardSpec& board) {
+  if (head_a.image_size.empty())
+    head_a.image_size = pairs.image_size;
+  std::vector<std::vector<cv::Point2f>> corners_a, corners_b;
+  for (const PairCorners& pair : pairs.pairs) {
+    if (!pair.found())
+      continue;
+    corners_a.push_back(pair.left);
+    corners_b.push_back(pair.right);
+  }
+  HeadToHeadReport report;
+  auto transform = calibrateHeadToHead(head_a, head_b, corners_a, corners_b, board, &report.rms);
+  if (!transform)
+    return transform.error();
+  report.b_to_a = *transform;
+  report.views_used = static_cast<int>(corners_a.size());
+  return report;
+}
+
+core::Result<std::filesystem::path> saveHeadToHead(const HeadToHeadReport& report,
+                                                   const std::filesystem::path& file) {
+  try {
+    cv::FileStorage storage(file.string(), cv::FileStorage::WRITE);
+    if (!storage.isOpened())
+      return core::Error{file.string() + ": cannot write"};
+    storage << "b_to_a" << cv::Mat(report.b_to_a) << "rms" << report.rms;
+  } catch (const cv::Exception&) {
+    return core::Error{file.string() + ": cannot write"};
+  }
+  return file;
 }
 
 }  // namespace fieldrig::stereo

@@ -1,5 +1,6 @@
 #include "fieldrig/stereo/preprocess.h"
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace fieldrig::stereo {
@@ -45,6 +46,25 @@ core::Result<cv::Mat> debayerAndScale(const cv::Mat& raw, core::PixelFormat form
   cv::Mat scaled;
   cv::resize(bgr, scaled, cv::Size(), scale, scale, cv::INTER_AREA);
   return scaled;
+}
+
+core::Result<cv::Mat> readFrameImage(const std::filesystem::path& file) {
+  cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+  if (image.empty())
+    return core::Error{file.string() + ": cannot read the image"};
+  if (image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
+    return core::Error{file.string() + ": not an 8-bit raw or colour image"};
+  return image;
+}
+
+cv::Mat toGrey(const cv::Mat& raw, core::PixelFormat format) {
+  if (format == core::PixelFormat::kMono8)
+    return raw;
+  cv::Mat bgr;
+  cv::cvtColor(raw, bgr, bgrConversionCode(format));
+  cv::Mat grey;
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  return grey;
 }
 
 cv::Mat mosaicBayer(const cv::Mat& bgr, core::PixelFormat format) {

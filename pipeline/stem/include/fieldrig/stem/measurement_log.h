@@ -1,9 +1,13 @@
 // A session's stem measurements as a CSV file (one row per measurement, repeats numbered per
 // stem) and the mean and SD of each stem's repeats (the paper measured every stem four times).
+// The file survives a crash (core/durable_file.h): a save is one durable append, and removing the
+// last measurement replaces the file atomically. One writer per file at a time: the functions do
+// no locking of their own.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,9 +37,15 @@ std::string toCsvRow(const MeasurementRecord& record);  // no newline
 // the file, line and field.
 core::Result<std::vector<MeasurementRecord>> readMeasurementLog(const std::filesystem::path& file);
 
-// Appends one row (writing the header first when the file is new or empty).
+// Appends one row (writing the header first when the file is new or empty) and waits until it
+// is on the disk. The error names the file.
 core::Result<bool> appendMeasurement(const std::filesystem::path& file,
                                      const MeasurementRecord& record);
+
+// Removes the last row of `session` (rows of other sessions sharing the file stay), rewriting the
+// file atomically. nullopt when the session has no row; the error names the file.
+core::Result<std::optional<MeasurementRecord>> removeLastMeasurement(
+    const std::filesystem::path& file, const std::string& session);
 
 // The repeat number the next measurement of `stem_label` in `session` gets.
 int nextRepeat(const std::vector<MeasurementRecord>& records, const std::string& session,

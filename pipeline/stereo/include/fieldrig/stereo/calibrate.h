@@ -3,6 +3,7 @@
 // sample reports, and the transform between two heads from a board both see at once.
 #pragma once
 
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -30,6 +31,18 @@ struct PairCorners {
   std::vector<cv::Point2f> left, right;
   bool found() const { return !left.empty() && !right.empty(); }
 };
+
+struct BoardPairs {
+  std::vector<PairCorners> pairs;  // one per image pair, in the given order
+  cv::Size image_size;             // of every image
+};
+
+// Reads the images `left[i]`, `right[i]` (same count) and finds the board in each; a pair counts
+// only when both images show it (its corners are cleared otherwise). The error names a file that
+// cannot be read or whose size differs from the first image's.
+core::Result<BoardPairs> findBoardInImagePairs(const std::vector<std::string>& left,
+                                               const std::vector<std::string>& right,
+                                               const BoardSpec& board);
 
 struct CalibrateOptions {
   // A view whose per-view RMS error (the worse of its two cameras) exceeds drop_factor × the
@@ -76,5 +89,23 @@ core::Result<cv::Matx44d> calibrateHeadToHead(
     const std::vector<std::vector<cv::Point2f>>& corners_a,
     const std::vector<std::vector<cv::Point2f>>& corners_b, const BoardSpec& board,
     double* rms = nullptr);
+
+struct HeadToHeadReport {
+  cv::Matx44d b_to_a = cv::Matx44d::eye();  // head B's frame → head A's frame
+  double rms = 0;
+  int views_used = 0;
+};
+
+// The same from image pairs whose left images are head A's left camera and right images head
+// B's left camera, taken at once (findBoardInImagePairs); the views where both saw the board are
+// used. A head calibration without an image size takes `pairs.image_size`.
+core::Result<HeadToHeadReport> calibrateHeadToHead(StereoCalibration head_a,
+                                                   const StereoCalibration& head_b,
+                                                   const BoardPairs& pairs, const BoardSpec& board);
+
+// Writes `b_to_a` (4×4, to copy into rig.yml) and `rms` to an OpenCV YAML file; the error names
+// the file.
+core::Result<std::filesystem::path> saveHeadToHead(const HeadToHeadReport& report,
+                                                   const std::filesystem::path& file);
 
 }  // namespace fieldrig::stereo

@@ -1,0 +1,49 @@
+// Offline processing of a recorded session, as `fieldrig process` runs it: every set (or every
+// N-th, for one shard of a batch job) through the plot processor into a results folder, by the
+// same adapter, result line and results writer as fieldrigd's live processing. It resumes: a set
+// whose trigger id the results already hold is skipped. A set that cannot be processed is kept in
+// the results with its status; it never stops the run.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "fieldrig/core/result.h"
+#include "fieldrig/daemon/results_writer.h"
+#include "fieldrig/gps/location_map.h"
+#include "fieldrig/pipeline/plot_processor.h"
+#include "fieldrig/recording/session_reader.h"
+
+namespace fieldrig::daemon {
+
+struct SessionProcessingOptions {
+  // This run takes the sets at positions shard_index, shard_index + shard_count, …: shards of a
+  // batch job get the same number of sets (±1) whatever the sessions' lengths.
+  std::size_t shard_index = 0;
+  std::size_t shard_count = 1;
+  // Also write each set's fused cloud here as PLOT_setN.ply (the processor must keep_cloud).
+  std::optional<std::filesystem::path> clouds_dir;
+};
+
+struct SessionProcessingSummary {
+  std::size_t sets = 0;  // processed by this run
+  std::size_t ok = 0;    // of those, with traits status ok
+  std::size_t partial_clouds = 0;
+  std::size_t unplaced = 0;      // neither a map location nor a fix
+  std::size_t already_done = 0;  // skipped: in the results before this run
+};
+
+// `on_line` sees each set's result line before it is added to `results`; `on_problem` hears of a
+// cloud that cannot be written. The error names a results file that cannot be written (the run
+// stops there). `map` may be null.
+core::Result<SessionProcessingSummary> processSession(
+    const recording::SessionReader& reader, pipeline::PlotProcessor& processor,
+    const gps::LocationMap* map, ResultsWriter& results, const SessionProcessingOptions& options,
+    const std::function<void(const nlohmann::ordered_json&)>& on_line,
+    const std::function<void(const std::string&)>& on_problem);
+
+}  // namespace fieldrig::daemon

@@ -1,0 +1,61 @@
+#include "fieldrig/daemon/session_processing.h"
+
+#include "fieldrig/core/time.h"
+#include "fieldrig/daemon/head_frames.h"
+
+namespace fieldrig::daemon {
+
+core::Result<SessionProcessingSummary> processSession(
+    const recording::SessionReader& reader, pipeline::PlotProcessor& processor,
+    const gps::LocationMap* map, ResultsWriter& results, const SessionProcessingOptions& options,
+    const std::function<void(const nlohmann::ordered_json&)>& on_line,
+    const std::function<void(const std::string&)>& on_problem) {
+  SessionProcessingSummary summary;
+  for (std::size_t position = 0; position < reader.sets().size(); ++position) {
+    const recording::IndexedSet& set = reader.sets()[position];
+    if (position % options.shard_count != options.shard_index)
+      continue;
+    if (results.contains(set.trigger_id)) {
+      ++summary.already_done;
+      continue;
+    }
+    std::vector<std::string> problems;
+    auto frames = headFramesFromRecording(reader, set.set_index, processor.rig(), problems);
+    pipeline::PlotResult result;
+    if (frames) {
+      result = processor.process(*frames, std::move(problems));
+    } else {
+      result.problems = std::move(problems);
+      result.problems.push_back(frames.error().message);
+      result.traits.status = traits::TraitsStatus::kEmptyCloud;
+      result.traits.message = frames.error().message;
+    }
+    PlotIdentity identity;
+    identity.set_index = set.set_index;
+    identity.trigger_id = set.trigger_id;
+    identity.location_id = set.location_id;
+    identity.time = core::formatIso8601(set.trigger_time, 6);
+    identity.position = plotPosition(set.location_id, set.fix, map);
+    identity.trigger_status = set.trigger_status.value_or("");
+    const nlohmann::ordered_json line = plotLine(identity, result);
+    if (options.clouds_dir && frames) {
+      const std::filesystem::path ply =
+          *options.clouds_dir /
+          (line.at("plot").get<std::string>() + "_set" + std::to_string(set.set_index) + ".ply");
+      if (auto written = cloud::writePly(result.cloud, ply); !written)
+        on_problem(written.error().message);
+    }
+    ++summary.sets;
+    summary.ok += result.traits.status == traits::TraitsStatus::kOk ? 1 : 0;
+    summary.partial_clouds += result.partial ? 1 : 0;
+    summary.unplaced += identity.position ? 0 : 1;
+    on_line(line);
+    if (std::string failed = results.add(line); !failed.empty())
+      return core::Error{std::move(failed)};
+  }
+  if (std::string failed = results.flush(); !failed.empty())
+    return core::Error{std::move(failed)};
+  return summary;
+}
+
+}  // namespace fieldrig::daemon

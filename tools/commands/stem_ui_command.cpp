@@ -1,0 +1,68 @@
+// `fieldrig stem-ui SESSION_DIR… [--port P] [--bind A] [--calib DIR] [--out CSV]`: serves the stem
+// measurement page (tools/stem_page) for the field team on a local port until interrupted. The
+// first stdout line names the URL (tests and scripts read the port from it, useful with --port 0).
+// Exit codes: 2 a session that cannot be opened or a bad --bind/--port; 3 cannot listen.
+#include <boost/asio/ip/address.hpp>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands/commands.h"
+#include "stem_page/http_server.h"
+#include "stem_page/stem_page.h"
+
+namespace fieldrig::tools {
+namespace {
+
+struct StemUiArgs {
+  stem_page::StemPageOptions page;
+  int port = 8765;
+  std::string bind = "127.0.0.1";
+};
+
+int runStemUi(StemUiArgs args) {
+  const char* who = "fieldrig stem-ui: ";
+  auto page = stem_page::StemPage::open(std::move(args.page));
+  if (!page) {
+    std::cerr << who << page.error().message << '\n';
+    return kExitBadInput;
+  }
+  boost::system::error_code ec;
+  const boost::asio::ip::address address = boost::asio::ip::make_address(args.bind, ec);
+  if (ec) {
+    std::cerr << who << "--bind: '" << args.bind << "' is not an IP address\n";
+    return kExitBadInput;
+  }
+  if (args.port < 0 || args.port > 65535) {
+    std::cerr << who << "--port: " << args.port << " is not a port\n";
+    return kExitBadInput;
+  }
+  auto server = stem_page::HttpServer::listen(address, static_cast<std::uint16_t>(args.port));
+  if (!server) {
+    std::cerr << who << server.error().message << '\n';
+    return kExitRuntime;
+  }
+  std::cout << who << "serving http://" << args.bind << ":" << (*server)->port() << "/"
+            << std::endl;
+  (*server)->run(
+      [&page](const stem_page::HttpRequest& request) { return (*page)->handle(request); });
+}
+
+}  // namespace
+
+void registerStemUiCommand(CLI::App& app, int& exit_code) {
+  CLI::App* command = app.add_subcommand(
+      "stem-ui", "Serve the stem measurement page for recorded sessions (http://127.0.0.1:PORT/)");
+  auto args = std::make_shared<StemUiArgs>();
+  command->add_option("sessions", args->page.sessions, "Session folders")->required();
+  command->add_option("--port", args->port, "TCP port (0: any free port)")->capture_default_str();
+  command->add_option("--bind", args->bind, "Address to listen on")->capture_default_str();
+  command->add_option("--calib", args->page.calib,
+                      "Calibration folder: DIR/{bottom,middle,top}/{intrinsics,extrinsics}.yml");
+  command->add_option("--out", args->page.out,
+                      "CSV of the measurements (default: SESSION_DIR/stem_measurements.csv)");
+  command->callback([args, &exit_code] { exit_code = runStemUi(*args); });
+}
+
+}  // namespace fieldrig::tools
