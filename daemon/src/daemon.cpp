@@ -36,7 +36,7 @@
 #include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/gps/trigger_replay.h"
 #include "fieldrig/pipeline/plot_processor.h"
-#include "nmea_player.h"
+#include "fieldrig/sim/nmea_player.h"
 #include "service_notifier.h"
 
 namespace fieldrig::daemon {
@@ -418,11 +418,12 @@ class Daemon {
   // Real time: the serial path of the field, from a device, or from a file played into a pty.
   void runLive(const fs::path& nmea_path, bool play_file) {
     boost::asio::io_context io;
-    std::unique_ptr<NmeaPlayer> player;
+    std::unique_ptr<sim::NmeaPtyPlayer> player;
     gps::SerialOptions serial = config_.gps.serial;
     serial.device = nmea_path.string();
     if (play_file) {
-      auto started = NmeaPlayer::start(nmea_path, [&io, this] {
+      // Every pause of the capture is played as it was: a GPS outage must look like one.
+      auto started = sim::NmeaPtyPlayer::start(nmea_path, sim::NmeaPacing{}, [&io, this] {
         // The file is over: give the last triggers their frames, then end the run.
         boost::asio::post(io, [this] { stop_requested_ = true; });
       });
