@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "fieldrig/core/durable_file.h"
+
 namespace fieldrig::stem {
 namespace {
 
@@ -173,15 +175,14 @@ core::Result<bool> appendMeasurement(const std::filesystem::path& file,
   std::error_code ec;
   const bool fresh =
       !std::filesystem::exists(file, ec) || std::filesystem::file_size(file, ec) == 0;
-  std::ofstream out(file, std::ios::app);
-  if (!out)
-    return core::Error{file.string() + ": cannot be opened for writing"};
+  // One durable append (header and row together for a new file): a measurement that was
+  // reported saved survives a crash, and a crash never leaves a header without its row.
+  std::string text;
   if (fresh)
-    out << csvHeader() << '\n';
-  out << toCsvRow(record) << '\n';
-  out.flush();
-  if (!out)
-    return core::Error{file.string() + ": write failed"};
+    text.append(csvHeader()).append(1, '\n');
+  text.append(toCsvRow(record)).append(1, '\n');
+  if (std::string error = core::appendDurably(file, text); !error.empty())
+    return core::Error{error};
   return true;
 }
 
