@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <system_error>
@@ -84,15 +85,8 @@ core::Result<LocationMap> openRecordingMap(const std::filesystem::path& path) {
 }
 
 std::string_view toString(HeadingSource source) {
-  switch (source) {
-    case HeadingSource::kCourse:
-      return "course";
-    case HeadingSource::kTrack:
-      return "track";
-    case HeadingSource::kNone:
-      return "none";
-  }
-  return "none";
+  constexpr std::array<std::string_view, 3> kNames = {"course", "track", "none"};  // enum order
+  return kNames[static_cast<std::size_t>(source)];
 }
 
 MapRecorder::MapRecorder(LocationMap map, MapRecorderOptions options,
