@@ -146,7 +146,8 @@ int run(int argc, char** argv) {
       std::istringstream in(nmea);
       auto t0 = std::chrono::steady_clock::now();
       gps::replayTriggers(in, *map, replay,
-                          {[&](const core::TriggerEvent& e) { events.push_back(e); }, {}});
+                          {[&](const core::TriggerEvent& e) { events.push_back(e); }, {}})
+          .value();
       auto t1 = std::chrono::steady_clock::now();
       predictive.push_back(sim::scoreTriggers(drive, *map, events));
       const auto naive_events = naiveTriggers(nmea, *map, drive.frame());

@@ -55,7 +55,7 @@ void runPlanner(benchmark::State& state, int rows, int plots) {
   std::size_t triggers = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    TriggerPlanner planner(field.map, {});
+    TriggerPlanner planner = TriggerPlanner::create(field.map, {}).value();
     state.ResumeTiming();
     for (const core::GpsFix& fix : fixes) {
       planner.addFix(fix, fix.time);

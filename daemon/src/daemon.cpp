@@ -31,14 +31,13 @@
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/daemon/results_writer.h"
 #include "fieldrig/daemon/status_server.h"
-#include "fieldrig/gps/live_trigger_chain.h"
 #include "fieldrig/gps/local_frame.h"
 #include "fieldrig/gps/location_map.h"
-#include "fieldrig/gps/serial_nmea_source.h"
+#include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/gps/trigger_replay.h"
 #include "fieldrig/pipeline/plot_processor.h"
+#include "fieldrig/sim/nmea_player.h"
 #include "fieldrig/sim/sim_camera.h"
-#include "nmea_player.h"
 #include "service_notifier.h"
 
 namespace fieldrig::daemon {
@@ -318,7 +317,8 @@ class Daemon {
         ++too_fast_;
       }
     }
-    alarm(missed ? "missed" : "too_fast", planner_alarm.message, planner_alarm.location_id);
+    alarm(std::string(gps::toString(planner_alarm.kind)), planner_alarm.message,
+          planner_alarm.location_id);
   }
 
   void onFix(const core::GpsFix& fix) {
@@ -406,10 +406,13 @@ class Daemon {
       onTrigger(event);
     };
     handlers.on_alarm = [this](const gps::PlannerAlarm& a) { onPlannerAlarm(a); };
-    const gps::ReplaySummary summary =
-        gps::replayTriggers(nmea, map_, config_.gps.triggers, handlers);
-    nmea_stats_ = summary.nmea;
-    planner_stats_ = summary.planner;
+    const auto summary = gps::replayTriggers(nmea, map_, config_.gps.triggers, handlers);
+    if (summary) {
+      nmea_stats_ = summary->nmea;
+      planner_stats_ = summary->planner;
+    } else {
+      spdlog::error("{}: {}", sourceName(), summary.error().message);
+    }
     control.stop();
     control_thread.join();
   }
@@ -417,10 +420,12 @@ class Daemon {
   // Real time: the serial path of the field, from a device, or from a file played into a pty.
   void runLive(const fs::path& nmea_path, bool play_file) {
     boost::asio::io_context io;
-    std::unique_ptr<NmeaPlayer> player;
-    std::string device = nmea_path.string();
+    std::unique_ptr<sim::NmeaPtyPlayer> player;
+    gps::SerialOptions serial = config_.gps.serial;
+    serial.device = nmea_path.string();
     if (play_file) {
-      auto started = NmeaPlayer::start(nmea_path, [&io, this] {
+      // Every pause of the capture is played as it was: a GPS outage must look like one.
+      auto started = sim::NmeaPtyPlayer::start(nmea_path, sim::NmeaPacing{}, [&io, this] {
         // The file is over: give the last triggers their frames, then end the run.
         boost::asio::post(io, [this] { stop_requested_ = true; });
       });
@@ -430,30 +435,24 @@ class Daemon {
         return;
       }
       player = std::move(*started);
-      device = player->devicePath();
+      serial.device = player->devicePath();
     }
-    gps::LiveTriggerChain chain(
-        io, map_, config_.gps.triggers,
-        [this](const core::TriggerEvent& event, core::SteadyTime) { onTrigger(event); },
-        [this](const gps::PlannerAlarm& a) { onPlannerAlarm(a); },
-        [this](const core::GpsFix& fix) { onFix(fix); });
-    gps::SerialOptions serial = config_.gps.serial;
-    serial.device = device;
-    std::unique_ptr<gps::SerialNmeaSource> source;
-    try {
-      source = std::make_unique<gps::SerialNmeaSource>(
-          io, serial,
-          [&chain](const gps::Sentence& sentence, const core::ReceptionStamp& received) {
-            chain.onSentence(sentence, received);
-          },
-          [this](const gps::SerialStatus& status) { onSerial(status); });
-    } catch (const std::invalid_argument& error) {
-      spdlog::error("{}: gps.serial: {}", sourceName(), error.what());
+    gps::LiveTriggerHandlers handlers;
+    handlers.on_trigger = [this](const core::TriggerEvent& event, core::SteadyTime) {
+      onTrigger(event);
+    };
+    handlers.on_alarm = [this](const gps::PlannerAlarm& a) { onPlannerAlarm(a); };
+    handlers.on_fix = [this](const core::GpsFix& fix) { onFix(fix); };
+    auto created = gps::SerialTriggerChain::create(
+        io, map_, serial, config_.gps.triggers, handlers,
+        [this](const gps::SerialStatus& status) { onSerial(status); });
+    if (!created) {
+      spdlog::error("{}: gps: {}", sourceName(), created.error().message);
       return;
     }
+    gps::SerialTriggerChain& chain = *created;
     boost::asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
     auto stop_all = [&] {
-      source->stop();
       chain.stop();
       io.stop();
     };
@@ -474,11 +473,11 @@ class Daemon {
     };
     arm();
     notifier_.startWatchdog(io);
-    source->start();
+    chain.start();
     notifier_.ready();
     io.run();
-    nmea_stats_ = source->stats();
-    planner_stats_ = chain.planner().stats();
+    nmea_stats_ = chain.nmeaStats();
+    planner_stats_ = chain.plannerStats();
   }
 
   void watchSignals(boost::asio::signal_set& signals, std::function<void()> on_stop) {

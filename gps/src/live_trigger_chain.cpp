@@ -9,15 +9,19 @@ namespace {
 constexpr std::size_t kOffsetWindow = 50;
 }  // namespace
 
-LiveTriggerChain::LiveTriggerChain(boost::asio::io_context& io, const LocationMap& map,
-                                   TriggerChainOptions options, TriggerHandler on_trigger,
-                                   AlarmHandler on_alarm, FixHandler on_fix)
-    : timer_(io),
-      options_(options),
-      on_trigger_(std::move(on_trigger)),
-      on_alarm_(std::move(on_alarm)),
-      on_fix_(std::move(on_fix)),
-      planner_(map, options.planner) {}
+core::Result<std::unique_ptr<LiveTriggerChain>> LiveTriggerChain::create(
+    boost::asio::io_context& io, const LocationMap& map, TriggerChainOptions options,
+    LiveTriggerHandlers handlers) {
+  core::Result<TriggerPlanner> planner = TriggerPlanner::create(map, options.planner);
+  if (!planner)
+    return planner.error();
+  return std::unique_ptr<LiveTriggerChain>(
+      new LiveTriggerChain(io, std::move(*planner), options, std::move(handlers)));
+}
+
+LiveTriggerChain::LiveTriggerChain(boost::asio::io_context& io, TriggerPlanner planner,
+                                   TriggerChainOptions options, LiveTriggerHandlers handlers)
+    : timer_(io), options_(options), handlers_(std::move(handlers)), planner_(std::move(planner)) {}
 
 std::optional<core::UtcTime> LiveTriggerChain::gpsTimeAt(core::SteadyTime steady) const {
   if (!offset_)
@@ -31,8 +35,8 @@ void LiveTriggerChain::onSentence(const Sentence& sentence, const core::Receptio
   const std::optional<core::GpsFix> fix = assembler_.add(sentence, received);
   if (!fix)
     return;
-  if (on_fix_)
-    on_fix_(*fix);
+  if (handlers_.on_fix)
+    handlers_.on_fix(*fix);
   // Fire what was due before this fix arrived: the timer may not have run yet.
   fireDue(received.steady);
 
@@ -53,12 +57,12 @@ void LiveTriggerChain::fireDue(core::SteadyTime now) {
   if (!gps_now)
     return;
   for (const core::TriggerEvent& event : planner_.collectDue(*gps_now)) {
-    if (on_trigger_)
-      on_trigger_(event, now);
+    if (handlers_.on_trigger)
+      handlers_.on_trigger(event, now);
   }
   for (const PlannerAlarm& alarm : planner_.takeAlarms()) {
-    if (on_alarm_)
-      on_alarm_(alarm);
+    if (handlers_.on_alarm)
+      handlers_.on_alarm(alarm);
   }
 }
 

@@ -3,18 +3,15 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
-#include <iterator>
 #include <optional>
 #include <sstream>
 #include <system_error>
 #include <tuple>
 #include <utility>
+
+#include "fieldrig/core/durable_file.h"
 
 // The CSV reader is hand-written on purpose: maps are small (a season's field is ~100,000
 // lines) and what matters is that a bad map is rejected at start-up with an error naming the
@@ -250,14 +247,11 @@ LocationMap::LocationMap(std::vector<std::string> metadata_columns)
     : metadata_columns_(std::move(metadata_columns)) {}
 
 core::Result<LocationMap> LocationMap::load(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    return core::Error{path.string() + ": cannot open: " + std::strerror(errno)};
-  }
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad())
-    return core::Error{path.string() + ": read error"};
-  return parse(text, path.string());
+  std::string error;
+  const std::optional<std::string> text = core::readWholeFile(path, error);
+  if (!text)
+    return core::Error{error};
+  return parse(*text, path.string());
 }
 
 core::Result<LocationMap> LocationMap::parse(std::string_view text, std::string_view source_name) {
@@ -422,29 +416,9 @@ std::string LocationMap::toCsv() const {
 }
 
 core::Result<bool> LocationMap::save(const std::filesystem::path& path) const {
-  // Written beside the target and renamed over it, so a crash never leaves half a map.
-  std::filesystem::path temporary = path;
-  temporary += ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      return core::Error{path.string() + ": cannot write: " + std::strerror(errno)};
-    }
-    const std::string text = toCsv();
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temporary, ignored);
-      return core::Error{path.string() + ": write failed"};
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::filesystem::remove(temporary, error);
-    return core::Error{path.string() + ": cannot replace: " + error.message()};
-  }
+  // Replaced whole or not at all: a crash never leaves half a map.
+  if (std::string error = core::replaceFileAtomically(path, toCsv()); !error.empty())
+    return core::Error{error};
   return true;
 }
 

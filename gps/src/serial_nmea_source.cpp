@@ -5,7 +5,6 @@
 #include <boost/asio/post.hpp>
 
 #include <algorithm>
-#include <stdexcept>
 #include <string_view>
 #include <utility>
 
@@ -37,6 +36,28 @@ std::string_view toString(SerialEvent event) {
   return "unknown";
 }
 
+core::Result<std::unique_ptr<SerialNmeaSource>> SerialNmeaSource::create(
+    boost::asio::io_context& io, SerialOptions options, SentenceHandler on_sentence,
+    StatusHandler on_status) {
+  if (std::find(kStandardBaudRates.begin(), kStandardBaudRates.end(), options.baud) ==
+      kStandardBaudRates.end()) {
+    return core::Error{
+        fmt::format("serial port {}: unsupported baud rate {} (use 4800, 9600, 19200, 38400, "
+                    "57600 or 115200)",
+                    options.device, options.baud)};
+  }
+  if (options.device.empty())
+    return core::Error{"serial port: empty device path"};
+  if (options.reopen_initial_delay.count() <= 0 ||
+      options.reopen_max_delay < options.reopen_initial_delay) {
+    return core::Error{fmt::format(
+        "serial port {}: reopen delays must satisfy 0 < initial ({} ms) <= max ({} ms)",
+        options.device, options.reopen_initial_delay.count(), options.reopen_max_delay.count())};
+  }
+  return std::unique_ptr<SerialNmeaSource>(
+      new SerialNmeaSource(io, std::move(options), std::move(on_sentence), std::move(on_status)));
+}
+
 SerialNmeaSource::SerialNmeaSource(boost::asio::io_context& io, SerialOptions options,
                                    SentenceHandler on_sentence, StatusHandler on_status)
     : io_(io),
@@ -50,23 +71,7 @@ SerialNmeaSource::SerialNmeaSource(boost::asio::io_context& io, SerialOptions op
         // stop() from inside a callback ends the callbacks even within the chunk being parsed.
         if (running_ && on_sentence_)
           on_sentence_(sentence, chunk_received_);
-      }) {
-  if (std::find(kStandardBaudRates.begin(), kStandardBaudRates.end(), options_.baud) ==
-      kStandardBaudRates.end()) {
-    throw std::invalid_argument(
-        fmt::format("serial port {}: unsupported baud rate {} (use 4800, 9600, 19200, 38400, "
-                    "57600 or 115200)",
-                    options_.device, options_.baud));
-  }
-  if (options_.device.empty())
-    throw std::invalid_argument("serial port: empty device path");
-  if (options_.reopen_initial_delay.count() <= 0 ||
-      options_.reopen_max_delay < options_.reopen_initial_delay) {
-    throw std::invalid_argument(fmt::format(
-        "serial port {}: reopen delays must satisfy 0 < initial ({} ms) <= max ({} ms)",
-        options_.device, options_.reopen_initial_delay.count(), options_.reopen_max_delay.count()));
-  }
-}
+      }) {}
 
 SerialNmeaSource::~SerialNmeaSource() {
   stop();

@@ -7,7 +7,6 @@
 #include <boost/geometry/index/rtree.hpp>
 #include <cmath>
 #include <numbers>
-#include <stdexcept>
 
 namespace fieldrig::gps {
 namespace {
@@ -264,9 +263,18 @@ struct TriggerPlanner::State {
   std::vector<IndexEntry> candidates;  // reused across queries
 };
 
-TriggerPlanner::TriggerPlanner(const LocationMap& map, TriggerOptions options) {
+std::string_view toString(AlarmKind kind) {
+  return kind == AlarmKind::kTooFast ? "too_fast" : "missed";
+}
+
+core::Result<TriggerPlanner> TriggerPlanner::create(const LocationMap& map,
+                                                    TriggerOptions options) {
   if (map.empty())
-    throw std::invalid_argument("the imaging-location map has no locations");
+    return core::Error{"the imaging-location map has no locations"};
+  return TriggerPlanner(map, options);
+}
+
+TriggerPlanner::TriggerPlanner(const LocationMap& map, TriggerOptions options) {
   state_ = std::make_unique<State>(map, options);
   std::vector<IndexEntry> entries;
   entries.reserve(map.size());

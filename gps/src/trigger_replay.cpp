@@ -8,9 +8,13 @@
 
 namespace fieldrig::gps {
 
-ReplaySummary replayTriggers(std::istream& nmea, const LocationMap& map,
-                             const TriggerChainOptions& options, const ReplayHandlers& handlers) {
-  TriggerPlanner planner(map, options.planner);
+core::Result<ReplaySummary> replayTriggers(std::istream& nmea, const LocationMap& map,
+                                           const TriggerChainOptions& options,
+                                           const ReplayHandlers& handlers) {
+  core::Result<TriggerPlanner> created = TriggerPlanner::create(map, options.planner);
+  if (!created)
+    return created.error();
+  TriggerPlanner& planner = *created;
   FixAssembler assembler;
   const core::Nanoseconds latency = core::fromSeconds(options.latency_s);
   std::optional<core::UtcTime> last_available;
@@ -51,7 +55,7 @@ ReplaySummary replayTriggers(std::istream& nmea, const LocationMap& map,
   // At the end of the capture the live daemon's timer would still fire what was planned.
   if (last_available)
     publish(*last_available + core::fromSeconds(options.planner.max_fix_age_s));
-  return {parser.stats(), planner.stats()};
+  return ReplaySummary{parser.stats(), planner.stats()};
 }
 
 }  // namespace fieldrig::gps

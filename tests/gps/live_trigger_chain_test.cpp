@@ -1,6 +1,7 @@
 // The live chain in real time: a simulated drive's sentences are delivered on an io_context at
 // the pace of their GPS times plus a known latency; triggers must fire on the steady clock at
-// the moment that corresponds to their planned GPS time.
+// the moment that corresponds to their planned GPS time. Creation errors of the chain and of the
+// serial chain in front of it.
 #include "fieldrig/gps/live_trigger_chain.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +10,7 @@
 #include <sstream>
 
 #include "fieldrig/gps/field_plan.h"
+#include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/sim/drive_simulator.h"
 #include "fieldrig/sim/trigger_accuracy.h"
 
@@ -62,9 +64,13 @@ TEST(LiveTriggerChainTest, FiresOnTheSteadyClockAtThePlannedGpsTime) {
     core::SteadyTime at;
   };
   std::vector<Fired> fired;
-  LiveTriggerChain chain(io, *map, options, [&](const core::TriggerEvent& e, core::SteadyTime at) {
+  LiveTriggerHandlers handlers;
+  handlers.on_trigger = [&](const core::TriggerEvent& e, core::SteadyTime at) {
     fired.push_back({e, at});
-  });
+  };
+  auto created = LiveTriggerChain::create(io, *map, options, handlers);
+  ASSERT_TRUE(created.ok()) << created.error().message;
+  LiveTriggerChain& chain = **created;
 
   // GPS time t is delivered at steady time origin + (t - start) + latency.
   const core::SteadyTime origin = std::chrono::steady_clock::now() + 100ms;
@@ -105,6 +111,43 @@ TEST(LiveTriggerChainTest, FiresOnTheSteadyClockAtThePlannedGpsTime) {
   const sim::TriggerAccuracy accuracy = sim::scoreTriggers(drive, *map, events);
   EXPECT_EQ(accuracy.fired_once, map->size());
   EXPECT_LT(accuracy.max_abs_m, 0.04);
+}
+
+TEST(LiveTriggerChainTest, AnEmptyMapIsAStartUpError) {
+  boost::asio::io_context io;
+  const LocationMap empty;
+  const auto chain = LiveTriggerChain::create(io, empty, {}, {});
+  ASSERT_FALSE(chain.ok());
+  EXPECT_EQ(chain.error().message, "the imaging-location map has no locations");
+}
+
+TEST(SerialTriggerChainTest, CreationReportsTheMapAndTheSerialOptionsAndOpensNothing) {
+  boost::asio::io_context io;
+  SerialOptions serial;
+  serial.device = "/dev/ttyUSB0";
+  auto chain = SerialTriggerChain::create(io, LocationMap{}, serial, {}, {});
+  ASSERT_FALSE(chain.ok());
+  EXPECT_EQ(chain.error().message, "the imaging-location map has no locations");
+
+  LocationMap map;
+  ImagingLocation location;
+  location.id = "A";
+  location.latitude_deg = 42.0;
+  location.longitude_deg = -93.6;
+  ASSERT_TRUE(map.add(location).ok());
+  serial.baud = 2400;
+  chain = SerialTriggerChain::create(io, map, serial, {}, {});
+  ASSERT_FALSE(chain.ok());
+  EXPECT_EQ(chain.error().message.rfind("serial port /dev/ttyUSB0: unsupported baud rate 2400", 0),
+            0u)
+      << chain.error().message;
+
+  serial.baud = 9600;
+  chain = SerialTriggerChain::create(io, map, serial, {}, {});
+  ASSERT_TRUE(chain.ok()) << chain.error().message;
+  EXPECT_EQ(chain->nmeaStats().lines, 0u);
+  EXPECT_EQ(chain->plannerStats().fixes, 0u);
+  EXPECT_EQ(io.poll(), 0u);  // nothing opened before start()
 }
 
 }  // namespace

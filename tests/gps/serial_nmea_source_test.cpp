@@ -201,7 +201,7 @@ class SerialNmeaSourceTest : public ::testing::Test {
 
   void startSource(SerialOptions options) {
     onIo([&] {
-      source_ = std::make_unique<SerialNmeaSource>(
+      auto created = SerialNmeaSource::create(
           io_, std::move(options),
           [this](const Sentence& s, const core::ReceptionStamp& stamp) {
             recorder_.onSentence(s, stamp);
@@ -209,6 +209,8 @@ class SerialNmeaSourceTest : public ::testing::Test {
               on_sentence_hook_(s);
           },
           [this](const SerialStatus& status) { recorder_.onStatus(status); });
+      ASSERT_TRUE(created.ok()) << created.error().message;
+      source_ = std::move(*created);
       source_->start();
     });
   }
@@ -567,35 +569,48 @@ INSTANTIATE_TEST_SUITE_P(GpsdCaptures, SerialReplayTest,
 
 // ---- start-up errors --------------------------------------------------------------------------
 
-TEST(SerialNmeaSourceOptions, NonStandardBaudRatesThrow) {
+TEST(SerialNmeaSourceOptions, NonStandardBaudRatesAreErrors) {
   boost::asio::io_context io;
   const auto make = [&](unsigned baud) {
     SerialOptions options;
     options.device = "/dev/ttyUSB0";
     options.baud = baud;
-    SerialNmeaSource source(io, options, [](const Sentence&, const core::ReceptionStamp&) {});
+    return SerialNmeaSource::create(io, options,
+                                    [](const Sentence&, const core::ReceptionStamp&) {});
   };
   for (unsigned baud : {0u, 300u, 2400u, 4801u, 14400u, 100000u, 230400u, 921600u}) {
-    EXPECT_THROW(make(baud), std::invalid_argument) << baud;
+    const auto source = make(baud);
+    ASSERT_FALSE(source.ok()) << baud;
+    EXPECT_EQ(source.error().message, "serial port /dev/ttyUSB0: unsupported baud rate " +
+                                          std::to_string(baud) +
+                                          " (use 4800, 9600, 19200, 38400, 57600 or 115200)");
   }
   for (unsigned baud : {4800u, 9600u, 19200u, 38400u, 57600u, 115200u}) {
-    EXPECT_NO_THROW(make(baud)) << baud;
+    EXPECT_TRUE(make(baud).ok()) << baud;
   }
-  // Construction opens nothing: an absent /dev/ttyUSB0 above is not an error until start().
+  // Creation opens nothing: an absent /dev/ttyUSB0 above is not an error until start().
   EXPECT_EQ(io.poll(), 0u);
 }
 
-TEST(SerialNmeaSourceOptions, EmptyDeviceAndBadDelaysThrow) {
+TEST(SerialNmeaSourceOptions, EmptyDeviceAndBadDelaysAreErrors) {
   boost::asio::io_context io;
   const auto handler = [](const Sentence&, const core::ReceptionStamp&) {};
   SerialOptions options;
-  EXPECT_THROW(SerialNmeaSource(io, options, handler), std::invalid_argument);
+  auto source = SerialNmeaSource::create(io, options, handler);
+  ASSERT_FALSE(source.ok());
+  EXPECT_EQ(source.error().message, "serial port: empty device path");
   options.device = "/dev/ttyUSB0";
   options.reopen_initial_delay = 0ms;
-  EXPECT_THROW(SerialNmeaSource(io, options, handler), std::invalid_argument);
+  source = SerialNmeaSource::create(io, options, handler);
+  ASSERT_FALSE(source.ok());
+  EXPECT_NE(source.error().message.find("reopen delays must satisfy"), std::string::npos);
   options.reopen_initial_delay = 500ms;
   options.reopen_max_delay = 100ms;
-  EXPECT_THROW(SerialNmeaSource(io, options, handler), std::invalid_argument);
+  source = SerialNmeaSource::create(io, options, handler);
+  ASSERT_FALSE(source.ok());
+  EXPECT_EQ(source.error().message,
+            "serial port /dev/ttyUSB0: reopen delays must satisfy 0 < initial (500 ms) <= max "
+            "(100 ms)");
 }
 
 }  // namespace

@@ -90,7 +90,7 @@ TEST(TriggerPlannerTest, FiresOncePerLocationAtThePredictedCrossing) {
   Field field;
   for (int i = 0; i < 5; ++i)
     field.addLocation("P" + std::to_string(i), 0.0, 1.3 + 3.7 * i);
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive d;
   d.duration_s = 15;  // north -10 … 20 m
   const auto events = drive(field, planner, d);
@@ -119,7 +119,7 @@ TEST(TriggerPlannerTest, HeadingMustMatchTheDirectionOfTravel) {
   field.addLocation("north_east_59", 0.0, 6.0, 59.0);
   field.addLocation("east_61", 0.0, 8.0, 61.0);
   field.addLocation("wraps_350", 0.0, 10.0, 350.0);
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   const auto events = drive(field, planner, Drive{});
   std::vector<std::string> ids;
   for (const auto& e : events)
@@ -132,7 +132,7 @@ TEST(TriggerPlannerTest, CrossTrackToleranceSeparatesNeighbouringRows) {
   field.addLocation("this_row_right", 0.4, 3.0);
   field.addLocation("this_row_left", -0.4, 5.0);
   field.addLocation("next_row", 0.76, 7.0);
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   const auto events = drive(field, planner, Drive{});
   ASSERT_EQ(events.size(), 2u);
   EXPECT_EQ(events[0].location_id, "this_row_right");
@@ -144,7 +144,7 @@ TEST(TriggerPlannerTest, CrossTrackToleranceSeparatesNeighbouringRows) {
 TEST(TriggerPlannerTest, InvalidFixesNeverTrigger) {
   Field field;
   field.addLocation("A", 0.0, 5.0);
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive d;
   d.valid = [](int) { return false; };
   EXPECT_TRUE(drive(field, planner, d).empty());
@@ -154,7 +154,7 @@ TEST(TriggerPlannerTest, InvalidFixesNeverTrigger) {
 TEST(TriggerPlannerTest, InvalidFixJustBeforeTheLocationDropsThePlan) {
   Field field;
   field.addLocation("A", 0.0, 5.05);  // crossed at k = 75.25
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive d;
   d.valid = [](int k) { return k < 75 || k > 90; };
   const auto events = drive(field, planner, d);
@@ -165,7 +165,7 @@ TEST(TriggerPlannerTest, LocationPassedDuringInvalidFixesIsReportedMissed) {
   Field field;
   field.addLocation("A", 0.0, 5.0);   // crossed at k = 75, while the fix is invalid
   field.addLocation("B", 0.0, 12.0);  // crossed at k = 110, valid again
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive d;
   d.duration_s = 13;
   d.valid = [](int k) { return k < 70 || k > 85; };
@@ -182,7 +182,7 @@ TEST(TriggerPlannerTest, LocationPassedDuringInvalidFixesIsReportedMissed) {
 TEST(TriggerPlannerTest, StoppedOrCreepingNeverTriggers) {
   Field field;
   field.addLocation("A", 0.0, 0.05);
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive d;
   d.speed = 0.1;  // 10 cm/s, below the 0.3 m/s minimum
   d.north_start = -0.5;
@@ -195,7 +195,7 @@ TEST(TriggerPlannerTest, StaleFixesDoNotFireOnExtrapolation) {
   field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
   TriggerOptions options;
   options.max_fix_age_s = 0.15;
-  TriggerPlanner planner(field.map(), options);
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), options).value();
   Drive d;
   // The receiver stalls after fix 72 (0.6 m before A): the crossing is planned for 7.5 s, within
   // the planning horizon, but 0.3 s after the last fix, more than a plan may rest on.
@@ -207,7 +207,7 @@ TEST(TriggerPlannerTest, StaleFixesDoNotFireOnExtrapolation) {
 TEST(TriggerPlannerTest, StalenessIsJudgedAtTheMomentOfFiring) {
   Field field;
   field.addLocation("A", 0.0, 5.0);  // crossed at 7.5 s
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   // Only fix 72 plans it; the next call comes long after (as replay does after a gap), but the
   // trigger's own moment was 0.3 s after its fix, within max_fix_age_s: it fires, on time.
   for (int k = 0; k <= 72; ++k) {
@@ -223,7 +223,7 @@ TEST(TriggerPlannerTest, StalenessIsJudgedAtTheMomentOfFiring) {
 TEST(TriggerPlannerTest, SameEpochVetoDropsThePlan) {
   Field field;
   field.addLocation("A", 0.0, 5.0);  // crossed at 7.5 s
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   std::vector<core::TriggerEvent> events;
   for (int k = 0; k <= 100; ++k) {
     const core::UtcTime t = kStart + k * 100ms;
@@ -245,7 +245,7 @@ TEST(TriggerPlannerTest, SameEpochVetoDropsThePlan) {
 TEST(TriggerPlannerTest, RecoversFromAJumpBackInTime) {
   Field field;
   field.addLocation("A", 0.0, 5.0);
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   // One glitched fix dated a day ahead, then the receiver goes on as before.
   planner.addFix(field.fixAt(kStart + 24h, 0.0, -20.0), kStart + 24h);
   const auto events = drive(field, planner, Drive{});
@@ -256,7 +256,7 @@ TEST(TriggerPlannerTest, RecoversFromAJumpBackInTime) {
 TEST(TriggerPlannerTest, LocationPassedDuringAGapIsReportedMissed) {
   Field field;
   field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive d;
   d.present = [](int k) { return k < 65 || k > 76; };  // 1.2 s gap: the track restarts
   const auto events = drive(field, planner, d);
@@ -274,7 +274,7 @@ TEST(TriggerPlannerTest, ShortGapIsBridgedLate) {
   TriggerOptions options;
   options.late_tolerance_m = 0.5;
   options.max_fix_age_s = 0.15;  // a plan may rest on a fix at most 0.15 s old
-  TriggerPlanner planner(field.map(), options);
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), options).value();
   Drive d;
   d.present = [](int k) { return k < 73 || k > 75; };  // fixes 73-75 lost
   const auto events = drive(field, planner, d);
@@ -290,7 +290,7 @@ TEST(TriggerPlannerTest, ShortGapIsBridgedLate) {
 TEST(TriggerPlannerTest, ShortGapIsBridgedOnTimeByExtrapolation) {
   Field field;
   field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive d;
   d.present = [](int k) { return k < 73 || k > 75; };
   const auto events = drive(field, planner, d);
@@ -306,7 +306,7 @@ TEST(TriggerPlannerTest, MinimumIntervalDelaysAndRaisesTooFast) {
   TriggerOptions options;
   options.min_trigger_interval_s = 0.25;
   options.late_tolerance_m = 1.0;
-  TriggerPlanner planner(field.map(), options);
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), options).value();
   const auto events = drive(field, planner, Drive{});
   ASSERT_EQ(events.size(), 2u);
   EXPECT_EQ(events[0].status, core::TriggerStatus::kOnTime);
@@ -321,7 +321,7 @@ TEST(TriggerPlannerTest, MinimumIntervalDelaysAndRaisesTooFast) {
 TEST(TriggerPlannerTest, FiresAgainOnALaterPass) {
   Field field;
   field.addLocation("A", 0.0, 5.0);
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive there;
   const auto first = drive(field, planner, there);
   Drive back;
@@ -338,7 +338,7 @@ TEST(TriggerPlannerTest, FiresAgainOnALaterPass) {
 TEST(TriggerPlannerTest, LatencyIsAccountedForCausally) {
   Field field;
   field.addLocation("A", 0.0, 5.01);  // crossed at 7.505 s, 5 ms after fix 75
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   std::vector<core::TriggerEvent> events;
   const auto latency = 50ms;
   for (int k = 0; k <= 120; ++k) {
@@ -363,7 +363,7 @@ TEST(TriggerPlannerTest, CrossingBeforeTheFixIsUsableFiresLate) {
   TriggerOptions options;
   options.max_fix_gap_s = 0.05;  // no prediction beyond 50 ms + tolerance of the newest fix
   options.cross_track_tolerance_m = 0.01;
-  TriggerPlanner planner(field.map(), options);
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), options).value();
   std::vector<core::TriggerEvent> events;
   // 20 Hz fixes, 80 ms latency: the crossing at 7.5 s is seen from fix 7.45 s (usable at
   // 7.53 s) only as 0.1 m ahead, beyond the tiny horizon; from fix 7.5 s, usable at 7.58 s, as
@@ -395,7 +395,7 @@ TEST(TriggerPlannerTest, SeasonSizedMapOnlyFiresTheLocationsDriven) {
     }
   }
   ASSERT_EQ(field.map().size(), 100000u);
-  TriggerPlanner planner(field.map(), {});
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   Drive d;
   d.east = 10 * 2.286;  // row 10
   d.duration_s = 25;    // north -10 … 40 m: plots 0…9
@@ -408,7 +408,9 @@ TEST(TriggerPlannerTest, SeasonSizedMapOnlyFiresTheLocationsDriven) {
 
 TEST(TriggerPlannerTest, EmptyMapIsAStartUpError) {
   LocationMap empty;
-  EXPECT_THROW(TriggerPlanner(empty, {}), std::invalid_argument);
+  const auto planner = TriggerPlanner::create(empty, {});
+  ASSERT_FALSE(planner.ok());
+  EXPECT_EQ(planner.error().message, "the imaging-location map has no locations");
 }
 
 }  // namespace

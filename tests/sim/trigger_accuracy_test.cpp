@@ -48,7 +48,7 @@ ReplayRun replay(double speed, std::uint32_t seed, double noise = 0.01) {
     triggers.push_back(e);
   };
   ReplayRun run;
-  run.summary = gps::replayTriggers(nmea, *map, gps::TriggerChainOptions{}, handlers);
+  run.summary = gps::replayTriggers(nmea, *map, gps::TriggerChainOptions{}, handlers).value();
   run.accuracy = scoreTriggers(drive, *map, triggers);
   return run;
 }
@@ -125,9 +125,10 @@ TEST(TriggerAccuracyTest, ReplayBridgesAShortGapInTheCaptureOnTime) {
   }
   std::istringstream in(nmea);
   std::vector<core::TriggerEvent> triggers;
-  const auto summary =
+  const gps::ReplaySummary summary =
       gps::replayTriggers(in, *map, gps::TriggerChainOptions{},
-                          {[&](const core::TriggerEvent& e) { triggers.push_back(e); }, {}});
+                          {[&](const core::TriggerEvent& e) { triggers.push_back(e); }, {}})
+          .value();
   const TriggerAccuracy accuracy = scoreTriggers(drive, *map, triggers);
   EXPECT_EQ(accuracy.fired_once, map->size());
   ASSERT_FALSE(triggers.empty());

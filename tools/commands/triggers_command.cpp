@@ -9,9 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands/commands.h"
-#include "fieldrig/gps/live_trigger_chain.h"
 #include "fieldrig/gps/location_map.h"
-#include "fieldrig/gps/serial_nmea_source.h"
+#include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/gps/trigger_replay.h"
 
 namespace fieldrig::tools {
@@ -25,10 +24,6 @@ struct TriggersArgs {
   unsigned baud = 115200;
   gps::TriggerChainOptions replay;
 };
-
-std::string_view alarmName(gps::AlarmKind kind) {
-  return kind == gps::AlarmKind::kTooFast ? "too_fast" : "missed";
-}
 
 Json triggerJson(const core::TriggerEvent& event) {
   Json line;
@@ -46,7 +41,7 @@ Json triggerJson(const core::TriggerEvent& event) {
 
 void printAlarm(const gps::PlannerAlarm& alarm) {
   Json line;
-  line["alarm"] = alarmName(alarm.kind);
+  line["alarm"] = gps::toString(alarm.kind);
   line["location"] = alarm.location_id;
   line["time"] = core::formatIso8601(alarm.time, 6);
   line["message"] = alarm.message;
@@ -71,52 +66,41 @@ Json summaryJson(const gps::LocationMap& map, const gps::NmeaStats& nmea,
   return Json{{"summary", out}};
 }
 
+Json serialStatusJson(const gps::SerialStatus& status) {
+  Json line;
+  line["serial"] = gps::toString(status.event);
+  line["device"] = status.device;
+  line["message"] = status.message;
+  return line;
+}
+
 // Live: the receiver on a serial device; triggers fire on a steady_timer until SIGINT/SIGTERM.
 int runLive(const TriggersArgs& args, const gps::LocationMap& map) {
   boost::asio::io_context io;
-  gps::TriggerChainOptions options;
-  options.planner = args.replay.planner;
-  options.latency_s = args.replay.latency_s;
-  gps::LiveTriggerChain chain(
-      io, map, options,
-      [](const core::TriggerEvent& event, core::SteadyTime) {
-        Json line = triggerJson(event);
-        line["host_time"] = core::formatIso8601(
-            std::chrono::time_point_cast<core::Nanoseconds>(std::chrono::system_clock::now()), 6);
-        std::cout << line.dump() << std::endl;
-      },
-      printAlarm);
   gps::SerialOptions serial;
   serial.device = args.nmea_path;
   serial.baud = args.baud;
-  std::unique_ptr<gps::SerialNmeaSource> source;
-  try {
-    source = std::make_unique<gps::SerialNmeaSource>(
-        io, serial,
-        [&chain](const gps::Sentence& sentence, const core::ReceptionStamp& received) {
-          chain.onSentence(sentence, received);
-        },
-        [](const gps::SerialStatus& status) {
-          Json line;
-          line["serial"] = status.event == gps::SerialEvent::kOpened ? "opened"
-                           : status.event == gps::SerialEvent::kLost ? "lost"
-                                                                     : "open_failed";
-          line["device"] = status.device;
-          line["message"] = status.message;
-          std::cerr << line.dump() << std::endl;
-        });
-  } catch (const std::invalid_argument& error) {
-    std::cerr << "fieldrig triggers: " << error.what() << '\n';
+  gps::LiveTriggerHandlers handlers;
+  handlers.on_trigger = [](const core::TriggerEvent& event, core::SteadyTime) {
+    Json line = triggerJson(event);
+    line["host_time"] = core::formatIso8601(
+        std::chrono::time_point_cast<core::Nanoseconds>(std::chrono::system_clock::now()), 6);
+    std::cout << line.dump() << std::endl;
+  };
+  handlers.on_alarm = printAlarm;
+  auto chain = gps::SerialTriggerChain::create(
+      io, map, serial, args.replay, handlers, [](const gps::SerialStatus& status) {
+        std::cerr << serialStatusJson(status).dump() << std::endl;
+      });
+  if (!chain) {
+    std::cerr << "fieldrig triggers: " << chain.error().message << '\n';
     return kExitBadInput;
   }
   boost::asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](const boost::system::error_code&, int) {
-    source->stop();
-    chain.stop();
-  });
-  source->start();
+  signals.async_wait([&](const boost::system::error_code&, int) { chain->stop(); });
+  chain->start();
   io.run();
-  std::cerr << summaryJson(map, source->stats(), chain.planner().stats()).dump() << std::endl;
+  std::cerr << summaryJson(map, chain->nmeaStats(), chain->plannerStats()).dump() << std::endl;
   return kExitOk;
 }
 
@@ -144,9 +128,13 @@ int runTriggers(const TriggersArgs& args) {
     std::cout << triggerJson(event).dump() << '\n';
   };
   handlers.on_alarm = printAlarm;
-  const gps::ReplaySummary summary = gps::replayTriggers(nmea, *map, args.replay, handlers);
+  const auto summary = gps::replayTriggers(nmea, *map, args.replay, handlers);
   std::cout.flush();
-  std::cerr << summaryJson(*map, summary.nmea, summary.planner).dump() << '\n';
+  if (!summary) {
+    std::cerr << "fieldrig triggers: " << summary.error().message << '\n';
+    return kExitBadInput;
+  }
+  std::cerr << summaryJson(*map, summary->nmea, summary->planner).dump() << '\n';
   return kExitOk;
 }
 

@@ -175,10 +175,15 @@ core::Result<bool> appendMeasurement(const std::filesystem::path& file,
   std::error_code ec;
   const bool fresh =
       !std::filesystem::exists(file, ec) || std::filesystem::file_size(file, ec) == 0;
-  // Header and row in one append: a crash cannot leave a header without its first row. (Built by
+  // One durable append (header and row together for a new file): a measurement that was
+  // reported saved survives a crash, and a crash never leaves a header without its row. (Built by
   // appending: GCC 12 -O3 gives a false-positive -Wrestrict on string + string.)
-  std::string text = fresh ? csvHeader() + '\n' : std::string();
-  text.append(toCsvRow(record)).append(1, '\n');
+  std::string text;
+  if (fresh)
+    text.append(csvHeader()).append(1, '
+');
+  text.append(toCsvRow(record)).append(1, '
+');
   // The durable helper syncs the file's folder, which must be named even for a bare file name.
   if (std::string failed = core::appendDurably(std::filesystem::absolute(file), text);
       !failed.empty())

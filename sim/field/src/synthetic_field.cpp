@@ -68,7 +68,8 @@ core::Result<FieldFiles> writeSyntheticField(
   handlers.on_trigger = [&](const core::TriggerEvent& event) {
     order.push_back(event.location_id);
   };
-  gps::replayTriggers(stream, *map, spec.triggers, handlers);
+  if (auto replayed = gps::replayTriggers(stream, *map, spec.triggers, handlers); !replayed)
+    return replayed.error();
   if (order.size() > static_cast<std::size_t>(spec.plots))
     order.resize(static_cast<std::size_t>(spec.plots));
   // The map keeps the locations that get a plot: the others (the last row's tail when plots do

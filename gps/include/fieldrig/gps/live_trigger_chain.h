@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 
+#include "fieldrig/core/result.h"
 #include "fieldrig/core/trigger_event.h"
 #include "fieldrig/gps/fix_assembler.h"
 #include "fieldrig/gps/nmea_parser.h"
@@ -24,14 +25,22 @@
 
 namespace fieldrig::gps {
 
+// What the live chain reports, on the io thread; any may be empty.
+struct LiveTriggerHandlers {
+  std::function<void(const core::TriggerEvent&, core::SteadyTime fired_at)> on_trigger;
+  std::function<void(const PlannerAlarm&)> on_alarm;
+  std::function<void(const core::GpsFix&)> on_fix;
+};
+
 class LiveTriggerChain {
  public:
-  using TriggerHandler = std::function<void(const core::TriggerEvent&, core::SteadyTime fired_at)>;
-  using AlarmHandler = std::function<void(const PlannerAlarm&)>;
-  using FixHandler = std::function<void(const core::GpsFix&)>;
-
-  LiveTriggerChain(boost::asio::io_context& io, const LocationMap& map, TriggerChainOptions options,
-                   TriggerHandler on_trigger, AlarmHandler on_alarm = {}, FixHandler on_fix = {});
+  // The map must outlive the chain; an empty map is an error.
+  static core::Result<std::unique_ptr<LiveTriggerChain>> create(boost::asio::io_context& io,
+                                                                const LocationMap& map,
+                                                                TriggerChainOptions options,
+                                                                LiveTriggerHandlers handlers);
+  LiveTriggerChain(const LiveTriggerChain&) = delete;
+  LiveTriggerChain& operator=(const LiveTriggerChain&) = delete;
 
   // Feed every sentence as it arrives (SerialNmeaSource's handler).
   void onSentence(const Sentence& sentence, const core::ReceptionStamp& received);
@@ -44,14 +53,14 @@ class LiveTriggerChain {
   const TriggerPlanner& planner() const { return planner_; }
 
  private:
+  LiveTriggerChain(boost::asio::io_context& io, TriggerPlanner planner, TriggerChainOptions options,
+                   LiveTriggerHandlers handlers);
   void armTimer();
   void fireDue(core::SteadyTime now);
 
   boost::asio::steady_timer timer_;
   TriggerChainOptions options_;
-  TriggerHandler on_trigger_;
-  AlarmHandler on_alarm_;
-  FixHandler on_fix_;
+  LiveTriggerHandlers handlers_;
   FixAssembler assembler_;
   TriggerPlanner planner_;
   std::deque<core::Nanoseconds> recent_offsets_;  // reception (steady) − fix time, per fix

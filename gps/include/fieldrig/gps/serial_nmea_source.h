@@ -19,6 +19,7 @@
 #include <string>
 #include <string_view>
 
+#include "fieldrig/core/result.h"
 #include "fieldrig/core/time.h"
 #include "fieldrig/gps/nmea_parser.h"
 
@@ -49,10 +50,12 @@ class SerialNmeaSource {
   using SentenceHandler = std::function<void(const Sentence&, const core::ReceptionStamp&)>;
   using StatusHandler = std::function<void(const SerialStatus&)>;
 
-  // Throws std::invalid_argument for a baud rate that is not one of the standard rates from 4800
-  // to 115200, an empty device path or non-positive / inverted reopen delays (start-up errors).
-  SerialNmeaSource(boost::asio::io_context& io, SerialOptions options, SentenceHandler on_sentence,
-                   StatusHandler on_status = {});
+  // Opens nothing yet. An error for a baud rate that is not one of the standard rates from 4800
+  // to 115200, an empty device path or non-positive / inverted reopen delays.
+  static core::Result<std::unique_ptr<SerialNmeaSource>> create(boost::asio::io_context& io,
+                                                                SerialOptions options,
+                                                                SentenceHandler on_sentence,
+                                                                StatusHandler on_status = {});
   ~SerialNmeaSource();
   SerialNmeaSource(const SerialNmeaSource&) = delete;
   SerialNmeaSource& operator=(const SerialNmeaSource&) = delete;
@@ -72,6 +75,9 @@ class SerialNmeaSource {
   const NmeaStats& stats() const { return parser_.stats(); }
 
  private:
+  SerialNmeaSource(boost::asio::io_context& io, SerialOptions options, SentenceHandler on_sentence,
+                   StatusHandler on_status);
+
   // Repeating log lines (a receiver left unplugged retries for hours) are throttled per event.
   struct LogThrottle {
     std::chrono::steady_clock::time_point last{};

@@ -18,9 +18,11 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "fieldrig/core/gps_fix.h"
+#include "fieldrig/core/result.h"
 #include "fieldrig/core/trigger_event.h"
 #include "fieldrig/gps/local_frame.h"
 #include "fieldrig/gps/location_map.h"
@@ -55,6 +57,7 @@ enum class AlarmKind {
   kTooFast,  // two triggers closer than min_trigger_interval_s: one was delayed
   kMissed,   // a location was passed without a trigger (gap, invalid or stale fixes)
 };
+std::string_view toString(AlarmKind kind);  // "too_fast", "missed"
 
 struct PlannerAlarm {
   AlarmKind kind = AlarmKind::kTooFast;
@@ -79,8 +82,8 @@ struct TriggerStats {
 
 class TriggerPlanner {
  public:
-  // The map must outlive the planner. Throws std::invalid_argument for an empty map.
-  TriggerPlanner(const LocationMap& map, TriggerOptions options);
+  // The map must outlive the planner; an empty map is an error.
+  static core::Result<TriggerPlanner> create(const LocationMap& map, TriggerOptions options);
   ~TriggerPlanner();
   TriggerPlanner(TriggerPlanner&&) noexcept;
   TriggerPlanner& operator=(TriggerPlanner&&) noexcept;
@@ -102,6 +105,8 @@ class TriggerPlanner {
   const LocalFrame& frame() const;
 
  private:
+  TriggerPlanner(const LocationMap& map, TriggerOptions options);
+
   struct State;
   std::unique_ptr<State> state_;
 };

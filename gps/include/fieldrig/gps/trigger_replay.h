@@ -9,6 +9,7 @@
 #include <functional>
 #include <istream>
 
+#include "fieldrig/core/result.h"
 #include "fieldrig/core/trigger_event.h"
 #include "fieldrig/gps/nmea_parser.h"
 #include "fieldrig/gps/trigger_planner.h"
@@ -25,7 +26,9 @@ struct ReplayHandlers {
   std::function<void(const PlannerAlarm&)> on_alarm;
 };
 
-ReplaySummary replayTriggers(std::istream& nmea, const LocationMap& map,
-                             const TriggerChainOptions& options, const ReplayHandlers& handlers);
+// An empty map is an error.
+core::Result<ReplaySummary> replayTriggers(std::istream& nmea, const LocationMap& map,
+                                           const TriggerChainOptions& options,
+                                           const ReplayHandlers& handlers);
 
 }  // namespace fieldrig::gps

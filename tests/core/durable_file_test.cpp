@@ -1,0 +1,166 @@
+// The durable-file helpers: what they write, the errors they return, and what a writer killed in
+// the middle of its work leaves behind (a child process appends or replaces in a loop and is
+// killed with SIGKILL at an arbitrary moment).
+#include "fieldrig/core/durable_file.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "support/temp_dir.h"
+
+namespace fieldrig::core {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using testing_support::ScopedTempDir;
+
+std::string read(const fs::path& path) {
+  std::string error;
+  const auto text = readWholeFile(path, error);
+  EXPECT_TRUE(text.has_value()) << error;
+  return text.value_or("");
+}
+
+// Record `index` of the append test: its number, then enough bytes that writing it takes a
+// while (so that a kill can land inside a write), then a newline.
+std::string appendRecord(int index) {
+  char head[32];
+  std::snprintf(head, sizeof head, "R%08d ", index);
+  return head + std::string(64 * 1024 + (index % 7) * 1000, static_cast<char>('a' + index % 26)) +
+         "\n";
+}
+
+// Version `index` of the replace test: its number, a large body, and an end mark.
+std::string replaceVersion(int index) {
+  char head[32];
+  std::snprintf(head, sizeof head, "V%08d\n", index);
+  return head + std::string(512 * 1024 + (index % 5) * 999, static_cast<char>('a' + index % 26)) +
+         "\nEND\n";
+}
+
+// Runs `work(i)` for i = 0, 1, … in a child process until it is killed, waits until `ready`
+// says the child is well under way, lets it run for `extra`, then kills it with SIGKILL.
+template <typename Work, typename Ready>
+void killMidWork(Work work, Ready ready, std::chrono::milliseconds extra) {
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    for (int i = 0;; ++i) {
+      if (!work(i).empty())
+        ::_exit(1);
+    }
+  }
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (!ready() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(1ms);
+  std::this_thread::sleep_for(extra);
+  ASSERT_EQ(::kill(child, SIGKILL), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  // Killed, not exited: an exit would mean a write failed, and the test would prove nothing.
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the writer exited with " << WEXITSTATUS(status);
+}
+
+TEST(DurableFileTest, WriteFullyWritesEveryByte) {
+  const ScopedTempDir dir("durable_write_fully");
+  const fs::path path = dir / "out.bin";
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  ASSERT_GE(fd, 0);
+  const std::string text = appendRecord(3);
+  EXPECT_EQ(writeFully(fd, text.data(), text.size()), 0);
+  ::close(fd);
+  EXPECT_EQ(read(path), text);
+  EXPECT_EQ(writeFully(-1, "x", 1), EBADF);
+}
+
+TEST(DurableFileTest, ReplaceAndAppendWriteWhatTheySayAndNameThePathInErrors) {
+  const ScopedTempDir dir("durable_basic");
+  const fs::path path = dir / "file.txt";
+  EXPECT_EQ(replaceFileAtomically(path, "one\n"), "");
+  EXPECT_EQ(read(path), "one\n");
+  EXPECT_EQ(replaceFileAtomically(path, "two\n"), "");
+  EXPECT_EQ(read(path), "two\n");
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  EXPECT_EQ(appendDurably(path, "three\n"), "");
+  EXPECT_EQ(appendDurably(dir / "new.txt", "first\n"), "");
+  EXPECT_EQ(read(path), "two\nthree\n");
+  EXPECT_EQ(read(dir / "new.txt"), "first\n");
+
+  const fs::path missing = dir / "no" / "such" / "file.txt";
+  EXPECT_NE(replaceFileAtomically(missing, "x").find(missing.parent_path().string()),
+            std::string::npos);
+  EXPECT_EQ(appendDurably(missing, "x").rfind(missing.string() + ": cannot open", 0), 0u);
+  std::string error;
+  EXPECT_FALSE(readWholeFile(missing, error).has_value());
+  EXPECT_EQ(error.rfind(missing.string() + ": cannot open", 0), 0u) << error;
+}
+
+TEST(DurableFileTest, AnAppenderKilledMidWriteLeavesEveryEarlierRecordWhole) {
+  for (const auto extra : {0ms, 7ms, 23ms, 61ms}) {
+    const ScopedTempDir dir("durable_append_kill");
+    const fs::path path = dir / "log.txt";
+    killMidWork([&](int i) { return appendDurably(path, appendRecord(i)); },
+                [&] {
+                  std::error_code missing;
+                  const auto size = fs::file_size(path, missing);
+                  return !missing && size > 4 * appendRecord(0).size();
+                },
+                extra);
+    const std::string text = read(path);
+    std::size_t pos = 0;
+    int index = 0;
+    while (pos < text.size()) {
+      const std::string expected = appendRecord(index);
+      const std::size_t end = text.find('\n', pos);
+      if (end == std::string::npos) {
+        // Only the last record may be torn, and then it is a beginning of the record that was
+        // being written, never a mix of two.
+        EXPECT_EQ(text.compare(pos, std::string::npos, expected, 0, text.size() - pos), 0)
+            << "torn record " << index << " is not a prefix of it";
+        break;
+      }
+      ASSERT_EQ(text.compare(pos, end + 1 - pos, expected), 0)
+          << "record " << index << " at byte " << pos << " is not whole (kill after "
+          << extra.count() << " ms)";
+      pos = end + 1;
+      ++index;
+    }
+    EXPECT_GE(index, 4) << "the child had appended at least four records before the kill";
+  }
+}
+
+TEST(DurableFileTest, AReplacerKilledMidWriteLeavesTheOldOrTheNewFileNeverAMix) {
+  for (const auto extra : {0ms, 5ms, 19ms, 43ms}) {
+    const ScopedTempDir dir("durable_replace_kill");
+    const fs::path path = dir / "state.txt";
+    ASSERT_EQ(replaceFileAtomically(path, replaceVersion(0)), "");
+    killMidWork([&](int i) { return replaceFileAtomically(path, replaceVersion(i + 1)); },
+                [&] {
+                  std::string error;
+                  const auto text = readWholeFile(path, error);
+                  return text && text->compare(0, 9, "V00000003") >= 0;
+                },
+                extra);
+    const std::string text = read(path);
+    int version = -1;
+    ASSERT_EQ(std::sscanf(text.c_str(), "V%08d", &version), 1) << text.substr(0, 20);
+    EXPECT_GE(version, 3);
+    EXPECT_TRUE(text == replaceVersion(version))
+        << "version " << version << " is not whole (" << text.size() << " bytes, expected "
+        << replaceVersion(version).size() << "; kill after " << extra.count() << " ms)";
+  }
+}
+
+}  // namespace
+}  // namespace fieldrig::core
