@@ -180,10 +180,8 @@ core::Result<bool> appendMeasurement(const std::filesystem::path& file,
   // appending: GCC 12 -O3 gives a false-positive -Wrestrict on string + string.)
   std::string text;
   if (fresh)
-    text.append(csvHeader()).append(1, '
-');
-  text.append(toCsvRow(record)).append(1, '
-');
+    text.append(csvHeader()).append(1, '\n');
+  text.append(toCsvRow(record)).append(1, '\n');
   // The durable helper syncs the file's folder, which must be named even for a bare file name.
   if (std::string failed = core::appendDurably(std::filesystem::absolute(file), text);
       !failed.empty())
