@@ -4,4 +4,5 @@ target_link_libraries(frame_handoff_bench PRIVATE fieldrig::core benchmark::benc
 # Whole-run benchmark: trigger → FrameSet latency (rig sink, acquisition consumer; p50/p99) and
 # the idle CPU of a started rig and acquisition, six sim cameras. Prints a Markdown table.
 add_executable(trigger_to_record_bench ${CMAKE_CURRENT_LIST_DIR}/trigger_to_record_bench.cpp)
-target_link_libraries(trigger_to_record_bench PRIVATE fieldrig::daemon fieldrig::drivers)
+target_link_libraries(trigger_to_record_bench PRIVATE fieldrig::daemon fieldrig::drivers
+                                                      fieldrig::sim_camera)

@@ -27,6 +27,7 @@
 
 #include "fieldrig/daemon/acquisition.h"
 #include "fieldrig/drivers/rig.h"
+#include "fieldrig/sim/sim_camera.h"
 
 namespace {
 
@@ -61,26 +62,26 @@ drivers::RigOptions sixSimCameras() {
 struct Latencies {
   std::vector<double> us;  // one per whole set that arrived
   std::size_t expected = 0;
-  std::uint64_t incomplete = 0;  // sets that left the rig incomplete (a frame timed out)
-  std::uint64_t skipped = 0;     // sets the consumer never saw (its queue was full)
+  std::uint64_t incomplete = 0;  // sets that left the rig incomplete: a frame missing or dropped
+  std::uint64_t frames_missing = 0;  // none before the rig's timeout
+  std::uint64_t frames_dropped = 0;  // no free buffer in the pool
+  std::uint64_t skipped = 0;         // sets the consumer never saw (its queue was full)
 };
 
 void printRow(const char* path, Latencies latencies) {
   std::vector<double>& v = latencies.us;
-  if (v.empty()) {
-    std::printf("| %s | 0/%zu | | | | %llu | %llu |\n", path, latencies.expected,
-                static_cast<unsigned long long>(latencies.incomplete),
-                static_cast<unsigned long long>(latencies.skipped));
-    return;
-  }
   std::sort(v.begin(), v.end());
   const auto at = [&](double q) {
+    if (v.empty())
+      return 0.0;
     const auto i = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
     return v[std::min(i, v.size() - 1)];
   };
-  std::printf("| %s | %zu/%zu | %.0f | %.0f | %.0f | %llu | %llu |\n", path, v.size(),
-              latencies.expected, at(0.5), at(0.99), v.back(),
+  std::printf("| %s | %zu/%zu | %.0f | %.0f | %.0f | %llu (%llu missing, %llu dropped) | %llu |\n",
+              path, v.size(), latencies.expected, at(0.5), at(0.99), at(1.0),
               static_cast<unsigned long long>(latencies.incomplete),
+              static_cast<unsigned long long>(latencies.frames_missing),
+              static_cast<unsigned long long>(latencies.frames_dropped),
               static_cast<unsigned long long>(latencies.skipped));
 }
 
@@ -122,6 +123,8 @@ Latencies rigLatency(int triggers, std::chrono::milliseconds interval) {
   std::this_thread::sleep_for(std::chrono::milliseconds{600});  // the last sets' timeout
   (*rig)->stop();
   latencies.incomplete = (*rig)->stats().incomplete_sets;
+  latencies.frames_missing = (*rig)->stats().frames_missing;
+  latencies.frames_dropped = (*rig)->stats().frames_dropped;
   return latencies;
 }
 
@@ -165,6 +168,8 @@ Latencies acquisitionLatency(const fs::path& dir, int triggers,
   acquisition->finish(std::chrono::seconds{10});
   const daemon::AcquisitionStats stats = acquisition->stats();
   latencies.incomplete = stats.rig.incomplete_sets;
+  latencies.frames_missing = stats.rig.frames_missing;
+  latencies.frames_dropped = stats.rig.frames_dropped;
   latencies.skipped = stats.sets_skipped_for_processing;
   return latencies;
 }
@@ -179,6 +184,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: trigger_to_record_bench [TRIGGERS] [INTERVAL_MS] [IDLE_S]\n");
     return 2;
   }
+  sim::addSimCamera(drivers::CameraRegistry::instance());  // drivers/ knows nothing of sim/
   const fs::path root =
       fs::temp_directory_path() / ("trigger_to_record_bench_" + std::to_string(::getpid()));
   fs::create_directories(root);
@@ -186,7 +192,7 @@ int main(int argc, char** argv) {
   std::printf("six sim cameras 160x120, %d triggers every %lld ms\n\n", triggers,
               static_cast<long long>(interval.count()));
   std::printf(
-      "| trigger → | whole sets | p50 µs | p99 µs | max µs | incomplete | skipped |\n"
+      "| trigger → | whole sets | p50 µs | p99 µs | max µs | incomplete (frames) | skipped |\n"
       "|---|---|---|---|---|---|---|\n");
   printRow("rig sink", rigLatency(triggers, interval));
   printRow("acquisition consumer", acquisitionLatency(root / "latency", triggers, interval));
