@@ -7,7 +7,6 @@
 namespace fieldrig::daemon {
 namespace {
 
-constexpr auto kIdlePoll = std::chrono::microseconds{500};
 // Sets whose frames went missing hold no buffers, so the pool alone does not bound the queue:
 // room for this many sets (about 1 KB each, allocated at start) before one could be lost.
 constexpr std::size_t kRecorderQueueSets = 4096;
@@ -68,12 +67,20 @@ core::Result<bool> Acquisition::start(ProcessSet process) {
   if (process_)
     processor_ = std::thread([this] { processLoop(); });
   auto started = rig_->start([this](core::FrameSet&& set) {
-    if (process_ && !to_processing_->tryPush(set)) {
-      skipped_.fetch_add(1, std::memory_order_relaxed);  // live processing only: it is recorded
+    if (process_) {
+      if (to_processing_->tryPush(set)) {
+        processing_bell_.ring();
+      } else {
+        skipped_.fetch_add(1, std::memory_order_relaxed);  // live processing only: it is recorded
+        progress_.ring();
+      }
     }
-    if (!to_recorder_->tryPush(set)) {
+    if (to_recorder_->tryPush(set)) {
+      recorder_bell_.ring();
+    } else {
       // Only when the recorder is thousands of sets behind: counted, and said loudly.
       lost_.fetch_add(1, std::memory_order_relaxed);
+      progress_.ring();
       spdlog::error("acquisition: recording queue full, set {} lost", set.trigger_id);
     }
   });
@@ -107,14 +114,37 @@ std::uint64_t Acquisition::inFlight() const {
   return in_flight;
 }
 
-void Acquisition::finish(std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline && !recording_stopped_ &&
-         recorded_.load() + lost_.load() + rig_->stats().triggers_refused < triggered_) {
-    std::this_thread::sleep_for(std::chrono::milliseconds{1});
+template <typename Done>
+void Acquisition::waitForProgress(Done done, std::optional<core::SteadyTime> deadline) {
+  while (true) {
+    const core::Doorbell::Ticket ticket = progress_.ticket();
+    if (done() || (deadline && std::chrono::steady_clock::now() >= *deadline))
+      return;
+    progress_.waitUntil(ticket, deadline);
   }
+}
+
+void Acquisition::waitForRoom(std::uint64_t room) {
+  waitForProgress([&] { return waits_interrupted_ || recording_stopped_ || inFlight() < room; },
+                  std::nullopt);
+}
+
+void Acquisition::interruptWaits() {
+  waits_interrupted_ = true;
+  progress_.ring();
+}
+
+void Acquisition::finish(std::chrono::milliseconds timeout) {
+  waitForProgress(
+      [&] {
+        return recording_stopped_ ||
+               recorded_.load() + lost_.load() + rig_->stats().triggers_refused >= triggered_;
+      },
+      std::chrono::steady_clock::now() + timeout);
   rig_->stop();  // emits what is still pending, incomplete
   running_ = false;
+  recorder_bell_.ring();
+  processing_bell_.ring();
   if (recorder_.joinable())
     recorder_.join();
   if (processor_.joinable())
@@ -126,10 +156,11 @@ void Acquisition::recordLoop() {
   recording::FrameSetRecord record;  // reused: its vectors and strings keep their capacity
   core::FrameSet set;
   while (true) {
+    const core::Doorbell::Ticket ticket = recorder_bell_.ticket();
     if (!to_recorder_->tryPop(set)) {
       if (!running_)
         return;
-      std::this_thread::sleep_for(kIdlePoll);
+      recorder_bell_.waitUntil(ticket, std::nullopt);
       continue;
     }
     if (writer_.stopped())
@@ -184,26 +215,30 @@ void Acquisition::recordLoop() {
     if (!outcome.ok()) {
       alarm_ = outcome.message;
       recording_stopped_ = true;
+      progress_.ring();
       spdlog::error("acquisition: recording stopped: {}", outcome.message);
       continue;
     }
     recorded_.fetch_add(1, std::memory_order_relaxed);
     bytes_.store(writer_.bytesWritten(), std::memory_order_relaxed);
+    progress_.ring();
   }
 }
 
 void Acquisition::processLoop() {
   core::FrameSet set;
   while (true) {
+    const core::Doorbell::Ticket ticket = processing_bell_.ticket();
     if (!to_processing_->tryPop(set)) {
       if (!running_)
         return;
-      std::this_thread::sleep_for(kIdlePoll);
+      processing_bell_.waitUntil(ticket, std::nullopt);
       continue;
     }
     process_(set);
     set = core::FrameSet{};
     processed_.fetch_add(1, std::memory_order_relaxed);
+    progress_.ring();
   }
 }
 

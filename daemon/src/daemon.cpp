@@ -383,7 +383,7 @@ class Daemon {
   void runVirtualTime(const fs::path& nmea_path) {
     boost::asio::io_context control;
     boost::asio::signal_set signals(control, SIGINT, SIGTERM, SIGHUP);
-    watchSignals(signals, [] {});
+    watchSignals(signals, [this] { acquisition_->interruptWaits(); });
     notifier_.startWatchdog(control);
     std::thread control_thread([&control] { control.run(); });
     notifier_.ready();
@@ -397,10 +397,7 @@ class Daemon {
     handlers.on_trigger = [&](const core::TriggerEvent& event) {
       if (stop_requested_)
         return;
-      while (!stop_requested_ && acquisition_->inFlight() >= room &&
-             !acquisition_->stats().recording_stopped) {
-        std::this_thread::sleep_for(std::chrono::microseconds{500});
-      }
+      acquisition_->waitForRoom(room);  // a stop request (signal) ends the wait too
       if (event.fix)
         onFix(*event.fix);
       onTrigger(event);

@@ -4,6 +4,10 @@
 //   rig thread ──► SpscQueue (sized to the pool: cannot overflow) ──► recorder thread ──► disk
 //             └──► SpscQueue (small) ──► processing thread (optional)
 //
+// Each consumer sleeps on its doorbell until the rig thread pushes a set (core::Doorbell: the
+// rig thread never waits on it); the owner's waits (finish, waitForRoom) sleep until a set
+// leaves the pipeline.
+//
 // The recording queue is sized far beyond the pool: when the disk falls behind, the pool runs
 // dry first and the cameras' frames are counted as dropped, in the open, while every set (if
 // only with missing frames) still reaches the recording.
@@ -16,10 +20,12 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "fieldrig/core/doorbell.h"
 #include "fieldrig/core/frame.h"
 #include "fieldrig/core/rig_layout.h"
 #include "fieldrig/core/spsc_queue.h"
@@ -68,6 +74,11 @@ class Acquisition {
   bool trigger();
   // Waits (bounded) until every triggered set has left the rig and been recorded, then stops.
   void finish(std::chrono::milliseconds timeout);
+  // Sleeps until fewer than `room` sets are in flight (see inFlight()), the recording stopped,
+  // or interruptWaits() was called. Virtual-time replay paces its triggers on this.
+  void waitForRoom(std::uint64_t room);
+  // Ends waitForRoom() now and for good: the run is stopping. Any thread.
+  void interruptWaits();
 
   AcquisitionStats stats() const;
   std::uint64_t triggered() const { return triggered_.load(); }
@@ -81,6 +92,9 @@ class Acquisition {
   explicit Acquisition(AcquisitionOptions options);
   void recordLoop();
   void processLoop();
+  // Owner thread: sleeps until done() or the deadline, looking again whenever a set leaves.
+  template <typename Done>
+  void waitForProgress(Done done, std::optional<core::SteadyTime> deadline);
 
   AcquisitionOptions options_;
   std::unique_ptr<drivers::Rig> rig_;
@@ -94,6 +108,10 @@ class Acquisition {
   std::atomic<bool> running_{false};
   std::thread recorder_;
   std::thread processor_;
+  core::Doorbell recorder_bell_;    // a set for the recorder, or the end of the run
+  core::Doorbell processing_bell_;  // a set for processing, or the end of the run
+  core::Doorbell progress_;         // a set left the pipeline (or the recording stopped)
+  std::atomic<bool> waits_interrupted_{false};
 
   std::atomic<std::uint64_t> recorded_{0}, lost_{0}, skipped_{0}, processed_{0}, bytes_{0};
   std::atomic<bool> recording_stopped_{false};

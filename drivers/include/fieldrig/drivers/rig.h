@@ -1,11 +1,10 @@
 // The camera rig: owns the cameras (six Grasshoppers as three stereo heads in the field),
 // triggers them together and groups their frames into one FrameSet per trigger.
 //
-// Grouping is an explicit ordered merge (STYLE.md item 7): sets leave in trigger-id order, each
-// as soon as every camera delivered, or when its timeout expires, marked incomplete with the
-// missing cameras. The spread of the frames' device timestamps is measured and flagged above a
-// tolerance. Frames reach the rig thread through one lock-free SPSC queue per camera; triggers
-// through another, so trigger() never blocks the GPS/trigger thread.
+// Grouping is the FrameGrouper's ordered merge, run on the rig's own thread. Frames reach that
+// thread through one lock-free SPSC queue per camera, triggers through another, and each push
+// rings the thread's doorbell: trigger() and the camera callbacks never wait, and the rig thread
+// sleeps until a frame or trigger arrives or the oldest waiting set is due.
 //
 // Thread contract: create/start/stop on the owner thread; trigger() on one thread (the
 // trigger thread); the SetSink runs on the rig's own thread and must not block.
@@ -15,13 +14,17 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "fieldrig/core/doorbell.h"
 #include "fieldrig/core/frame.h"
 #include "fieldrig/core/spsc_queue.h"
 #include "fieldrig/drivers/camera.h"
+#include "fieldrig/drivers/frame_grouper.h"
 
 namespace fieldrig::drivers {
 
@@ -35,14 +38,15 @@ struct RigOptions {
 
 struct RigStats {
   std::uint64_t triggers = 0;
-  std::uint64_t triggers_refused = 0;         // not taken at all: no set will come
+  std::uint64_t triggers_refused = 0;  // not taken at all (not running, id not increasing): no set
   std::uint64_t camera_triggers_refused = 0;  // a camera could not take it: its frame will miss
   std::uint64_t sets = 0;
   std::uint64_t incomplete_sets = 0;
   std::uint64_t frames_missing = 0;  // no frame before the timeout
   std::uint64_t frames_corrupt = 0;
-  std::uint64_t frames_dropped = 0;     // pool exhausted or rig queue full
-  std::uint64_t frames_unexpected = 0;  // for no pending trigger (late, or never triggered)
+  std::uint64_t frames_dropped = 0;  // pool exhausted or rig queue full
+  std::uint64_t frames_unexpected =
+      0;  // fit no waiting set: late, duplicate, unknown camera or trigger
   std::uint64_t skew_flagged = 0;
   std::uint64_t sets_forced_out = 0;  // left incomplete early: too many sets were waiting
   std::int64_t max_skew_ns = 0;
@@ -62,8 +66,9 @@ class Rig {
   core::Result<bool> start(SetSink sink);
   // Stops the cameras, emits what is pending (incomplete), joins the rig thread.
   void stop();
-  // Triggers every camera for `event.trigger_id` (increasing); the event travels with the set
-  // (its sent_time is stamped here). Never blocks; false if refused.
+  // Triggers every camera for `event.trigger_id`; the event travels with the set (its sent_time
+  // is stamped here). Never blocks; false if refused: not running, or the id is not above the
+  // previous trigger's (ids order the merge).
   bool trigger(const core::TriggerEvent& event);
   // A trigger that no location asked for (manual, tests, `fieldrig acquire`).
   bool trigger(std::uint64_t trigger_id);
@@ -74,44 +79,34 @@ class Rig {
   const core::FramePool& pool() const { return *pool_; }
 
  private:
-  struct Pending {
-    core::FrameSet set;
-    core::SteadyTime deadline{};
-    std::uint32_t arrived = 0;
+  struct IssuedTrigger {
+    core::TriggerEvent event;
+    core::SteadyTime issued{};
   };
 
   Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras);
   void run();
-  bool drain();
-  void emitReady(bool flush_all);
-  void emit(Pending& pending);
-  Pending* findPending(std::uint64_t trigger_id);
-  void popFront();
+  void drainTriggers();
+  void drainFrames();
+  void publishStats();
 
   RigOptions options_;
   std::vector<std::unique_ptr<Camera>> cameras_;
   std::unique_ptr<core::FramePool> pool_;
   std::vector<std::unique_ptr<core::SpscQueue<core::Frame>>> frame_queues_;  // one per camera
-  struct IssuedTrigger {
-    core::TriggerEvent event;
-    core::SteadyTime issued{};
-  };
   core::SpscQueue<IssuedTrigger> trigger_queue_{1024};
+  core::Doorbell wake_;  // rung by trigger() and the camera callbacks, and by stop()
   SetSink sink_;
-  // Sets waiting for frames, oldest at pending_head_: a ring allocated at construction, so that
-  // grouping allocates nothing per set (rig thread only).
-  std::vector<Pending> pending_;
-  std::size_t pending_head_ = 0;
-  std::size_t pending_count_ = 0;
+  FrameGrouper grouper_;                          // rig thread only
+  std::optional<std::uint64_t> last_trigger_id_;  // trigger thread only
   std::atomic<bool> running_{false};
   std::thread thread_;
 
-  // Counters written by their owning thread, read by stats().
+  // Counters of the trigger thread and the camera callbacks.
   std::atomic<std::uint64_t> triggers_{0}, triggers_refused_{0}, camera_refusals_{0},
       frames_dropped_{0};
-  std::atomic<std::uint64_t> sets_{0}, incomplete_{0}, missing_{0}, corrupt_{0}, unexpected_{0},
-      skew_flagged_{0}, forced_out_{0};
-  std::atomic<std::int64_t> max_skew_ns_{0};
+  mutable std::mutex stats_mutex_;
+  FrameGrouperStats grouping_stats_;  // guarded by stats_mutex_: the rig thread's copy for stats()
 };
 
 }  // namespace fieldrig::drivers
