@@ -7,8 +7,8 @@
 // DIR defaults to the system temporary folder; the session folders are removed afterwards. Each
 // policy stops after SECONDS (default 4) or 150 sets (~1.8 GB), whichever comes first, so the
 // run stays under ~2 GB of disk (each policy's folder is removed, and the disk synced, before
-// the next). CPU time is the process's user + system time (getrusage); the kernel's own writeback
-// threads are not in it.
+// the next). CPU time is the process's user + system time (CLOCK_PROCESS_CPUTIME_ID); the kernel's
+// own writeback threads are not in it.
 #include <sys/resource.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -22,6 +22,8 @@
 #include "fieldrig/recording/session_writer.h"
 #include "recording/synthetic_sets.h"
 
+#include "process_cpu.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -31,15 +33,6 @@ using Clock = std::chrono::steady_clock;
 constexpr int kWidth = 1624;
 constexpr int kHeight = 1224;
 constexpr std::uint64_t kMaxSets = 150;
-
-double cpuSeconds() {
-  rusage usage{};
-  ::getrusage(RUSAGE_SELF, &usage);
-  const auto seconds = [](const timeval& t) {
-    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
-  };
-  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
-}
 
 // Writes sets until `seconds` pass or kMaxSets are written; prints one table row.
 bool runPolicy(const fs::path& root, recording::FsyncPolicy policy, double seconds,
@@ -53,7 +46,7 @@ bool runPolicy(const fs::path& root, recording::FsyncPolicy policy, double secon
     std::fprintf(stderr, "%s\n", opened.error().message.c_str());
     return false;
   }
-  const double cpu_start = cpuSeconds();
+  const double cpu_start = fieldrig::bench::processCpuSeconds();
   const Clock::time_point start = Clock::now();
   const Clock::time_point end =
       start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
@@ -69,7 +62,7 @@ bool runPolicy(const fs::path& root, recording::FsyncPolicy policy, double secon
   }
   writer.close();
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  const double cpu = cpuSeconds() - cpu_start;
+  const double cpu = fieldrig::bench::processCpuSeconds() - cpu_start;
   const double megabytes = static_cast<double>(writer.bytesWritten()) / 1e6;
   std::printf("| %-9s | %5llu | %6.1f | %7.1f | %8.0f | %11.2f | %9.2f |\n",
               label != nullptr ? label : std::string(recording::toString(policy)).c_str(),
@@ -103,14 +96,14 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(kMaxSets));
   // The writer checksums every frame (CRC-32, zlib); its share of the CPU time per set:
   {
-    const double cpu_start = cpuSeconds();
+    const double cpu_start = fieldrig::bench::processCpuSeconds();
     constexpr int kRounds = 20;
     uLong crc = 0;
     for (int round = 0; round < kRounds; ++round) {
       for (const recording::FrameView& frame : rig.record(1, std::nullopt).frames)
         crc = ::crc32(crc, frame.pixels.data(), static_cast<uInt>(frame.pixels.size()));
     }
-    const double ms = 1e3 * (cpuSeconds() - cpu_start) / kRounds;
+    const double ms = 1e3 * (fieldrig::bench::processCpuSeconds() - cpu_start) / kRounds;
     std::printf("CRC-32 of one set (zlib %s): %.2f ms CPU (%.0f MB/s) [%lx]\n\n", zlibVersion(), ms,
                 6.0 * kWidth * kHeight / 1e3 / ms, crc);
   }

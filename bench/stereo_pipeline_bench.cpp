@@ -18,17 +18,15 @@
 #include "fieldrig/core/time.h"
 #include "support/plane_rig_scene.h"
 
+#include "process_cpu.h"
+
 namespace {
 
 using namespace fieldrig;
 using Clock = std::chrono::steady_clock;
 
-// CPU time of the whole process (all threads), ms: unlike wall time it barely moves when other
-// processes load the machine.
 double processCpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
+  return 1e3 * fieldrig::bench::processCpuSeconds();
 }
 
 struct StageTimes {

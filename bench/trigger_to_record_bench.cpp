@@ -6,8 +6,8 @@
 // - rig: Rig::trigger() → the rig's SetSink (the rig thread grouped the six frames);
 // - acquisition: Acquisition::trigger() → the processing thread holding the set (rig thread,
 //   then the consumer queue; the recorder's queue is the same kind of hop, beside it);
-// - idle CPU: user + system time of the whole process (getrusage) over IDLE_S seconds of a
-//   started rig, then of a started acquisition with processing, with no trigger, as % of a core.
+// - idle CPU: user + system time of the whole process (CLOCK_PROCESS_CPUTIME_ID) over IDLE_S
+//   seconds of a started rig, then of a started acquisition with processing, with no trigger, as % of a core.
 //
 // Triggers are paced every INTERVAL_MS (default 10, 300 triggers) so that each set travels
 // alone; frames are 160×120 so that the sim cameras' pixel filling stays small next to the
@@ -29,20 +29,13 @@
 #include "fieldrig/drivers/rig.h"
 #include "fieldrig/sim/sim_camera.h"
 
+#include "process_cpu.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 using namespace fieldrig;
 using Clock = std::chrono::steady_clock;
-
-double cpuSeconds() {
-  rusage usage{};
-  ::getrusage(RUSAGE_SELF, &usage);
-  const auto seconds = [](const timeval& t) {
-    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
-  };
-  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
-}
 
 drivers::RigOptions sixSimCameras() {
   drivers::RigOptions options;
@@ -68,6 +61,27 @@ struct Latencies {
   std::uint64_t skipped = 0;         // sets the consumer never saw (its queue was full)
 };
 
+// The latency of a whole set, from when its trigger was sent (`sent[trigger id]`).
+void recordLatency(Latencies& latencies, const std::vector<Clock::time_point>& sent,
+                   const core::FrameSet& set) {
+  if (set.complete() && set.trigger_id < sent.size()) {
+    latencies.us.push_back(
+        std::chrono::duration<double, std::micro>(Clock::now() - sent[set.trigger_id]).count());
+  }
+}
+
+// Triggers 1 … sent.size() - 1, `interval` apart, noting in `sent` when each was fired.
+template <typename Fire>
+void triggerAtInterval(std::vector<Clock::time_point>& sent, std::chrono::milliseconds interval,
+                       Fire fire) {
+  const Clock::time_point start = Clock::now() + interval;
+  for (std::size_t i = 1; i < sent.size(); ++i) {
+    std::this_thread::sleep_until(start + static_cast<int>(i) * interval);
+    sent[i] = Clock::now();
+    fire(static_cast<int>(i));
+  }
+}
+
 void printRow(const char* path, Latencies latencies) {
   std::vector<double>& v = latencies.us;
   std::sort(v.begin(), v.end());
@@ -87,11 +101,11 @@ void printRow(const char* path, Latencies latencies) {
 
 // Sleeps `seconds` with the given parts started and idle; returns the process's CPU share.
 double idleCpuPercent(double seconds) {
-  const double cpu_start = cpuSeconds();
+  const double cpu_start = fieldrig::bench::processCpuSeconds();
   const Clock::time_point start = Clock::now();
   std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  return 100.0 * (cpuSeconds() - cpu_start) / wall;
+  return 100.0 * (fieldrig::bench::processCpuSeconds() - cpu_start) / wall;
 }
 
 Latencies rigLatency(int triggers, std::chrono::milliseconds interval) {
@@ -105,21 +119,10 @@ Latencies rigLatency(int triggers, std::chrono::milliseconds interval) {
   latencies.expected = static_cast<std::size_t>(triggers);
   latencies.us.reserve(latencies.expected);
   // The sink runs on the rig thread; `sent[id]` was written before trigger(id) pushed the id.
-  if (!(*rig)->start([&](core::FrameSet&& set) {
-        if (set.complete() && set.trigger_id < sent.size()) {
-          latencies.us.push_back(
-              std::chrono::duration<double, std::micro>(Clock::now() - sent[set.trigger_id])
-                  .count());
-        }
-      })) {
+  if (!(*rig)->start([&](core::FrameSet&& set) { recordLatency(latencies, sent, set); })) {
     std::exit(1);
   }
-  const Clock::time_point start = Clock::now() + interval;
-  for (int i = 1; i <= triggers; ++i) {
-    std::this_thread::sleep_until(start + i * interval);
-    sent[static_cast<std::size_t>(i)] = Clock::now();
-    (*rig)->trigger(static_cast<std::uint64_t>(i));
-  }
+  triggerAtInterval(sent, interval, [&](int i) { (*rig)->trigger(static_cast<std::uint64_t>(i)); });
   std::this_thread::sleep_for(std::chrono::milliseconds{600});  // the last sets' timeout
   (*rig)->stop();
   latencies.incomplete = (*rig)->stats().incomplete_sets;
@@ -150,21 +153,11 @@ Latencies acquisitionLatency(const fs::path& dir, int triggers,
   latencies.expected = static_cast<std::size_t>(triggers);
   latencies.us.reserve(latencies.expected);
   // A new session numbers its sets from 1: the i-th trigger is set i.
-  if (!acquisition->start([&](const core::FrameSet& set) {
-        if (set.complete() && set.trigger_id < sent.size()) {
-          latencies.us.push_back(
-              std::chrono::duration<double, std::micro>(Clock::now() - sent[set.trigger_id])
-                  .count());
-        }
-      })) {
+  if (!acquisition->start(
+          [&](const core::FrameSet& set) { recordLatency(latencies, sent, set); })) {
     std::exit(1);
   }
-  const Clock::time_point start = Clock::now() + interval;
-  for (int i = 1; i <= triggers; ++i) {
-    std::this_thread::sleep_until(start + i * interval);
-    sent[static_cast<std::size_t>(i)] = Clock::now();
-    acquisition->trigger();
-  }
+  triggerAtInterval(sent, interval, [&](int) { acquisition->trigger(); });
   acquisition->finish(std::chrono::seconds{10});
   const daemon::AcquisitionStats stats = acquisition->stats();
   latencies.incomplete = stats.rig.incomplete_sets;
