@@ -7,7 +7,8 @@
 // - acquisition: Acquisition::trigger() → the processing thread holding the set (rig thread,
 //   then the consumer queue; the recorder's queue is the same kind of hop, beside it);
 // - idle CPU: user + system time of the whole process (CLOCK_PROCESS_CPUTIME_ID) over IDLE_S
-//   seconds of a started rig, then of a started acquisition with processing, with no trigger, as % of a core.
+//   seconds of a started rig, then of a started acquisition with processing, with no trigger,
+//   as % of a core.
 //
 // Triggers are paced every INTERVAL_MS (default 10, 300 triggers) so that each set travels
 // alone; frames are 160×120 so that the sim cameras' pixel filling stays small next to the
