@@ -1,6 +1,6 @@
 // The bandwidth planner against numbers worked out by hand (frame = 1624 × 1224 = 1,987,776
 // bytes of RAW8; 8,000 bus cycles a second).
-#include "fieldrig/drivers/iso_bandwidth.h"
+#include "fieldrig/drivers/dc1394/iso_bandwidth.h"
 
 #include <gtest/gtest.h>
 

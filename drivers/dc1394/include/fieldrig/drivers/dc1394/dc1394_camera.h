@@ -28,7 +28,7 @@
 #include "fieldrig/core/spsc_queue.h"
 #include "fieldrig/drivers/camera.h"
 #include "fieldrig/drivers/dc1394/dc1394_settings.h"
-#include "fieldrig/drivers/iso_bandwidth.h"
+#include "fieldrig/drivers/dc1394/iso_bandwidth.h"
 
 namespace fieldrig::drivers {
 

@@ -27,7 +27,7 @@
 #include "fieldrig/core/pixel_format.h"
 #include "fieldrig/core/result.h"
 #include "fieldrig/drivers/camera.h"
-#include "fieldrig/drivers/iso_bandwidth.h"
+#include "fieldrig/drivers/dc1394/iso_bandwidth.h"
 
 namespace fieldrig::drivers {
 

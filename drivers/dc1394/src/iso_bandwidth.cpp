@@ -1,4 +1,4 @@
-#include "fieldrig/drivers/iso_bandwidth.h"
+#include "fieldrig/drivers/dc1394/iso_bandwidth.h"
 
 #include <algorithm>
 #include <cmath>
