@@ -6,3 +6,4 @@ target_link_libraries(frame_handoff_bench PRIVATE fieldrig::core benchmark::benc
 add_executable(trigger_to_record_bench ${CMAKE_CURRENT_LIST_DIR}/trigger_to_record_bench.cpp)
 target_link_libraries(trigger_to_record_bench PRIVATE fieldrig::daemon fieldrig::drivers
                                                       fieldrig::sim_camera)
+target_include_directories(trigger_to_record_bench PRIVATE ${PROJECT_SOURCE_DIR}/tests)

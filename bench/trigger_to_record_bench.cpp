@@ -31,6 +31,7 @@
 #include "fieldrig/sim/sim_camera.h"
 
 #include "process_cpu.h"
+#include "support/sim_cameras.h"
 
 namespace {
 
@@ -39,15 +40,7 @@ using namespace fieldrig;
 using Clock = std::chrono::steady_clock;
 
 drivers::RigOptions sixSimCameras() {
-  drivers::RigOptions options;
-  options.driver = "sim";
-  for (int i = 0; i < 6; ++i) {
-    drivers::CameraConfig camera;
-    camera.id = std::to_string(i);
-    camera.width = 160;
-    camera.height = 120;
-    options.cameras.push_back(camera);
-  }
+  drivers::RigOptions options = testing_support::sixSimCameras(160, 120);
   options.frame_timeout = std::chrono::milliseconds{500};
   options.pool_sets = 32;
   return options;

@@ -22,14 +22,7 @@ using testing_support::ScopedTempDir;
 
 AcquisitionOptions smallRig(const std::filesystem::path& dir) {
   AcquisitionOptions options;
-  for (int i = 0; i < 6; ++i) {
-    drivers::CameraConfig camera;
-    camera.id = std::to_string(i);
-    camera.width = 80;
-    camera.height = 60;
-    options.rig.cameras.push_back(camera);
-  }
-  options.rig.frame_timeout = 100ms;
+  options.rig = testing_support::sixSimCameras(80, 60);
   options.session_dir = dir / "session";
   options.writer.fsync = recording::FsyncPolicy::kNone;
   return options;

@@ -17,16 +17,7 @@ namespace {
 using namespace std::chrono_literals;
 
 RigOptions sixCameras(std::uint32_t width = 64, std::uint32_t height = 48) {
-  RigOptions options;
-  for (int i = 0; i < 6; ++i) {
-    CameraConfig camera;
-    camera.id = std::to_string(i);
-    camera.width = width;
-    camera.height = height;
-    options.cameras.push_back(camera);
-  }
-  options.frame_timeout = 100ms;
-  return options;
+  return testing_support::sixSimCameras(width, height);
 }
 
 using Collector = testing_support::FrameSetCollector;

@@ -39,18 +39,12 @@ constexpr int kRecordedSets = 12;
 // replay (configured with the default Bayer format) has to take the format from the recording.
 std::filesystem::path recordSession(const std::filesystem::path& dir) {
   daemon::AcquisitionOptions options;
-  for (int i = 0; i < 6; ++i) {
-    CameraConfig camera;
-    camera.id = std::to_string(i);
-    camera.width = kWidth;
-    camera.height = kHeight;
+  options.rig = testing_support::sixSimCameras(kWidth, kHeight);
+  for (CameraConfig& camera : options.rig.cameras)
     camera.format = core::PixelFormat::kMono8;
-    options.rig.cameras.push_back(camera);
-  }
   options.rig.cameras[2].options["drop_every"] = "4";
   options.rig.cameras[1].options["corrupt_every"] = "5";
   options.rig.cameras[5].options["clock_offset_us"] = "250";
-  options.rig.frame_timeout = 100ms;
   options.session_dir = dir / "recorded";
   options.writer.fsync = recording::FsyncPolicy::kNone;
   auto acquisition = daemon::Acquisition::create(options, testing_support::camerasWithSim());
@@ -69,17 +63,11 @@ std::filesystem::path recordSession(const std::filesystem::path& dir) {
 
 RigOptions replayingRig(const std::filesystem::path& session,
                         const std::map<std::string, std::string>& extra = {}) {
-  RigOptions options;
-  for (int i = 0; i < 6; ++i) {
-    CameraConfig camera;
-    camera.id = std::to_string(i);
-    camera.width = kWidth;
-    camera.height = kHeight;
+  RigOptions options = testing_support::sixSimCameras(kWidth, kHeight);
+  for (CameraConfig& camera : options.cameras) {
     camera.options = extra;
     camera.options["session"] = session.string();
-    options.cameras.push_back(camera);
   }
-  options.frame_timeout = 100ms;
   options.max_skew = 1000us;  // the recorded 250 µs is replayed, not flagged
   options.pool_sets = 64;     // the collector keeps every set (and its buffers) to the end
   return options;

@@ -18,6 +18,9 @@ using Json = nlohmann::ordered_json;
 cloud::RigCalibration idealRig(const IdealRigGeometry& geometry) {
   const core::RigLayout layout;
   const cv::Size image_size(kIdealImageWidth, kIdealImageHeight);
+  // A head the geometry leaves out sits at 0 m, level: never an empty vector's front().
+  const double bottom_height =
+      geometry.head_heights_m.empty() ? 0.0 : geometry.head_heights_m.front();
   cloud::RigCalibration rig;
   for (std::size_t i = 0; i < layout.heads.size(); ++i) {
     cloud::HeadCalibration head;
@@ -29,7 +32,7 @@ cloud::RigCalibration idealRig(const IdealRigGeometry& geometry) {
     const double tilt_deg =
         i < geometry.head_tilts_down_deg.size() ? geometry.head_tilts_down_deg[i] : 0;
     const double tilt = tilt_deg * CV_PI / 180.0;
-    head.to_bottom(1, 3) = -(height - geometry.head_heights_m.front());
+    head.to_bottom(1, 3) = -(height - bottom_height);
     head.to_bottom(1, 1) = std::cos(tilt);
     head.to_bottom(1, 2) = std::sin(tilt);
     head.to_bottom(2, 1) = -std::sin(tilt);
