@@ -10,7 +10,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "stem/stem_campaign.h"
+#include "support/stem_campaign.h"
 
 int main(int argc, char** argv) {
   using namespace fieldrig::testing_support;

@@ -6,7 +6,7 @@
 
 #include <random>
 
-#include "stem/stem_campaign.h"
+#include "support/stem_campaign.h"
 
 namespace {
 

@@ -57,7 +57,7 @@ TEST(ProcessCli, SyntheticSessionGivesTraitsCloseToTruth) {
     const Json& expected = truth.at(plot);
     // Height through stereo: measured 1.4–4.1 cm low on these plots, most on the tallest (thin
     // leaf tips at the top head's edge of view are lost at 812×612); the 3 cm of the traits issue
-    // holds on clouds without stereo (tests/traits), not yet through it.
+    // holds on clouds without stereo (tests/pipeline/traits), not yet through it.
     EXPECT_NEAR(traits.at("height_m").get<double>(), expected.at("height_m").get<double>(), 0.05);
     // Width is not held against truth here: SGBM fills the small gaps between leaves, through
     // which the far backdrop shows, with disparities between the two, and those points (1.5–1.7 m

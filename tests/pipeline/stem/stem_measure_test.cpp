@@ -6,7 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
-#include "stem/stem_campaign.h"
+#include "support/stem_campaign.h"
 
 namespace fieldrig::stem {
 namespace {

@@ -7,7 +7,7 @@
 #include <random>
 #include <sstream>
 
-#include "stem/stem_campaign.h"
+#include "support/stem_campaign.h"
 #include "support/cli_run.h"
 #include "support/temp_dir.h"
 

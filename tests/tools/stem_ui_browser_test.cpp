@@ -19,7 +19,7 @@
 
 #include "fieldrig/recording/session_writer.h"
 #include "fieldrig/stem/measurement_log.h"
-#include "stem/stem_campaign.h"
+#include "support/stem_campaign.h"
 #include "support/cli_run.h"
 #include "support/temp_dir.h"
 
