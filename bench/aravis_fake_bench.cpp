@@ -4,26 +4,23 @@
 // lost and corrupt frames, the slowest trigger() call.
 //
 //   aravis_fake_bench [COUNT=200] [WIDTH=1624] [HEIGHT=1224] [LOST_PER_THOUSAND=0]
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
-#include <mutex>
 #include <string>
-#include <thread>
-#include <vector>
 
 #include "fieldrig/drivers/aravis/aravis_camera.h"
+#include "support/aravis_fakes.h"
+#include "support/collector.h"
 
 namespace {
 
 using namespace std::chrono_literals;
 using fieldrig::drivers::AravisCamera;
+using fieldrig::testing_support::Collector;
+using fieldrig::testing_support::configureWhenUp;
+using fieldrig::testing_support::FakeGvCamera;
+using fieldrig::testing_support::triggerInStep;
 
 int run(int argc, char** argv) {
   const int count = argc > 1 ? std::atoi(argv[1]) : 200;
@@ -35,60 +32,31 @@ int run(int argc, char** argv) {
     return 1;
   }
 
-  std::vector<std::string> args = {FIELDRIG_ARV_FAKE_GV_CAMERA, "-i", "lo", "-r", loss};
-  const pid_t fake = fork();
-  if (fake == 0) {
-    std::vector<char*> argv_fake;
-    for (auto& arg : args)
-      argv_fake.push_back(arg.data());
-    argv_fake.push_back(nullptr);
-    execv(argv_fake[0], argv_fake.data());
-    _exit(127);
-  }
-
   int rc = 0;
   {
+    FakeGvCamera fake(loss);
     AravisCamera camera;
     fieldrig::drivers::CameraConfig config;
-    config.id = "127.0.0.1";
+    config.id = FakeGvCamera::address();
     config.format = fieldrig::core::PixelFormat::kMono8;
     config.width = width;
     config.height = height;
-    const auto deadline = std::chrono::steady_clock::now() + 10s;
-    auto configured = camera.configure(config);
-    while (!configured.ok() && std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(100ms);
-      configured = camera.configure(config);
-    }
+    const auto configured = configureWhenUp(camera, config, fake);
     fieldrig::core::FramePool pool(16, std::size_t{width} * height);
-    std::mutex mutex;
-    std::condition_variable changed;
-    std::size_t frames = 0;  // guarded by mutex
+    // Only the count matters here: each frame's metadata is kept, its buffer goes back at once.
+    Collector<fieldrig::core::FrameMetadata> frames;
     if (!configured.ok()) {
       std::fprintf(stderr, "%s\n", configured.error().message.c_str());
       rc = 1;
-    } else if (auto started = camera.start(pool,
-                                           [&](fieldrig::core::Frame&&) {
-                                             std::lock_guard lock(mutex);
-                                             ++frames;
-                                             changed.notify_all();
-                                           });
+    } else if (auto started = camera.start(
+                   pool, frames.sinkKeeping<fieldrig::core::Frame>(
+                             [](const fieldrig::core::Frame& frame) { return frame.metadata; }));
                !started.ok()) {
       std::fprintf(stderr, "%s\n", started.error().message.c_str());
       rc = 1;
     } else {
-      std::chrono::nanoseconds slowest{0};
       const auto begin = std::chrono::steady_clock::now();
-      for (int i = 1; i <= count; ++i) {
-        std::unique_lock lock(mutex);
-        const std::size_t before = frames;
-        lock.unlock();
-        const auto t0 = std::chrono::steady_clock::now();
-        camera.trigger(static_cast<std::uint64_t>(i));
-        slowest = std::max(slowest, std::chrono::steady_clock::now() - t0);
-        lock.lock();
-        changed.wait_for(lock, 500ms, [&] { return frames > before; });
-      }
+      const auto slowest = triggerInStep(camera, frames, count, 500ms).slowest;
       const double seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
       camera.stop();
@@ -109,8 +77,6 @@ int run(int argc, char** argv) {
           static_cast<unsigned long long>(s.stream_underruns));
     }
   }
-  kill(fake, SIGTERM);
-  waitpid(fake, nullptr, 0);
   return rc;
 }
 

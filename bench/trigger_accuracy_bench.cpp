@@ -15,22 +15,14 @@
 #include "fieldrig/gps/fix_assembler.h"
 #include "fieldrig/gps/trigger_replay.h"
 #include "fieldrig/sim/trigger_accuracy.h"
+#include "support/field_plans.h"
 
 namespace fieldrig {
 namespace {
 
+// Eight rows of about 70 m, slightly east of north.
 gps::FieldPlan fieldPlan() {
-  gps::FieldPlan plan;
-  plan.row_start_latitude_deg = 42.0;
-  plan.row_start_longitude_deg = -93.6;
-  plan.row_end_latitude_deg = 42.0006;  // about 70 m, slightly east of north
-  plan.row_end_longitude_deg = -93.5998;
-  plan.rows = 8;
-  plan.plot_length_m = 3.0;
-  plan.alley_length_m = 1.0;
-  plan.row_spacing_m = 2.286;
-  plan.start_offset_m = 0.5;
-  return plan;
+  return testing_support::fieldPlan({42.0, -93.6}, {42.0006, -93.5998}, 8, 3.0, 0.5);
 }
 
 // The naive rule: fire at the first fix whose position is past the location along the row.

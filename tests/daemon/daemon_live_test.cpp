@@ -19,6 +19,7 @@
 
 #include "support/cli_process.h"
 #include "support/daemon_run.h"
+#include "support/field_plans.h"
 #include "support/socat_pty.h"
 #include "support/temp_dir.h"
 
@@ -186,33 +187,15 @@ TEST(DaemonLive, ProcessingSlowerThanTheDriveLosesNothingAndFieldrigProcessCompl
   // pty) and the paper's surface area (MLS + greedy triangulation, 2-3 s a plot here) behind a
   // one-set queue: live processing must fall behind and skip, whatever the machine's load.
   const fs::path fast_nmea = dir.path() / "fast.nmea";
-  const auto drive = testing_support::runFieldrig({"sim",
-                                                   "drive",
-                                                   "--row-start",
-                                                   "42.0106,-93.7385",
-                                                   "--row-end",
-                                                   "42.0110,-93.7385",
-                                                   "--rows",
-                                                   "2",
-                                                   "--plots",
-                                                   "6",
-                                                   "--plot-length",
-                                                   "3",
-                                                   "--alley-length",
-                                                   "1",
-                                                   "--row-spacing",
-                                                   "2.286",
-                                                   "--start-offset",
-                                                   "1",
-                                                   "--speed",
-                                                   "6",
-                                                   "--seed",
-                                                   "7",
-                                                   "--out-nmea",
-                                                   fast_nmea.string(),
-                                                   "--out-map",
-                                                   (dir.path() / "fast-map.csv").string()},
-                                                  dir.path());
+  gps::FieldPlan plan =
+      testing_support::fieldPlan({42.0106, -93.7385}, {42.0110, -93.7385}, 2, 3.0, 1.0);
+  plan.plots_per_row = 6;
+  const auto drive = testing_support::runFieldrig(
+      testing_support::withFieldPlan(
+          {"sim", "drive"}, plan,
+          {"--speed", "6", "--seed", "7", "--out-nmea", fast_nmea.string(), "--out-map",
+           (dir.path() / "fast-map.csv").string()}),
+      dir.path());
   ASSERT_EQ(drive.exit_code, 0) << drive.err;
   const std::string slow_traits = "pipeline:\n  queue_sets: 1\n  traits:\n    area_method: paper\n";
   const fs::path config =

@@ -3,27 +3,24 @@
 // over UDP on the loopback, with and without its packet-loss option. Every wait is bounded.
 #include "fieldrig/drivers/aravis/aravis_camera.h"
 
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/file.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
-#include <condition_variable>
 #include <cstring>
-#include <mutex>
-#include <thread>
 #include <vector>
 
 #include "fieldrig/drivers/rig.h"
+#include "support/aravis_fakes.h"
+#include "support/collector.h"
 
 namespace fieldrig::drivers {
 namespace {
 
 using namespace std::chrono_literals;
+using testing_support::configureWhenUp;
+using testing_support::FakeGvCamera;
+using testing_support::triggerInStep;
 
 constexpr std::uint32_t kWidth = 320;
 constexpr std::uint32_t kHeight = 240;
@@ -46,56 +43,17 @@ struct Seen {
   std::vector<std::uint8_t> head;  // the first row
 };
 
-// Collects frames from the driver's stream thread; the test thread waits for a count.
-class Collector {
- public:
-  Camera::FrameSink sink() {
-    return [this](core::Frame&& frame) {
-      Seen seen{frame.metadata, {}};
-      if (frame.buffer) {
-        const auto bytes = frame.buffer.bytes();
-        seen.head.assign(bytes.begin(), bytes.begin() + frame.metadata.width);
-      }
-      std::lock_guard lock(mutex_);
-      frames_.push_back(std::move(seen));
-      changed_.notify_all();
-    };
+Seen keepHead(const core::Frame& frame) {
+  Seen seen{frame.metadata, {}};
+  if (frame.buffer) {
+    const auto bytes = frame.buffer.bytes();
+    seen.head.assign(bytes.begin(), bytes.begin() + frame.metadata.width);
   }
-  std::size_t count() {
-    std::lock_guard lock(mutex_);
-    return frames_.size();
-  }
-  bool waitFor(std::size_t count, std::chrono::milliseconds timeout) {
-    std::unique_lock lock(mutex_);
-    return changed_.wait_for(lock, timeout, [&] { return frames_.size() >= count; });
-  }
-  std::vector<Seen> frames() {
-    std::lock_guard lock(mutex_);
-    return frames_;
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::vector<Seen> frames_;  // guarded by mutex_
-};
-
-// Triggers `count` frames one after another, each after the previous frame came or `timeout`
-// passed, whichever is first (the fakes poll their trigger register once per 40 ms frame period, so
-// triggers closer than that would merge into one frame). Returns the longest time one trigger()
-// call took.
-std::chrono::nanoseconds triggerInStep(Camera& camera, Collector& collector, int count,
-                                       std::chrono::milliseconds timeout) {
-  std::chrono::nanoseconds slowest{0};
-  for (int i = 1; i <= count; ++i) {
-    const std::size_t frames = collector.count();
-    const auto before = std::chrono::steady_clock::now();
-    EXPECT_TRUE(camera.trigger(static_cast<std::uint64_t>(i)));
-    slowest = std::max(slowest, std::chrono::steady_clock::now() - before);
-    collector.waitFor(frames + 1, timeout);
-  }
-  return slowest;
+  return seen;
 }
+
+// Frames from the driver's stream thread, as Seen: collector.sinkKeeping<core::Frame>(keepHead).
+using Collector = testing_support::Collector<Seen>;
 
 std::unique_ptr<Camera> createAravis() {
   auto camera = CameraRegistry::instance().create("aravis");
@@ -114,12 +72,13 @@ TEST(AravisCameraTest, InProcessFakeGivesOneFramePerTrigger) {
   ASSERT_TRUE(camera->configure(cameraConfig("Fake_1")).ok());
   core::FramePool pool(8, std::size_t{kWidth} * kHeight);
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sink()).ok());
+  ASSERT_TRUE(camera->start(pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
   constexpr int kTriggers = 10;
-  const auto slowest = triggerInStep(*camera, collector, kTriggers, 1s);
+  const auto triggered = triggerInStep(*camera, collector, kTriggers, 1s);
   camera->stop();
+  EXPECT_EQ(triggered.refused, 0);
 
-  const auto frames = collector.frames();
+  const auto frames = collector.items();
   ASSERT_EQ(frames.size(), std::size_t{kTriggers});
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const core::FrameMetadata& m = frames[i].metadata;
@@ -139,7 +98,7 @@ TEST(AravisCameraTest, InProcessFakeGivesOneFramePerTrigger) {
   EXPECT_EQ(stats.triggers_accepted, std::uint64_t{kTriggers});
   EXPECT_EQ(stats.frames_delivered, std::uint64_t{kTriggers});
   EXPECT_EQ(stats.frames_lost, 0u);
-  EXPECT_LT(slowest, 10ms) << "trigger() must only queue";
+  EXPECT_LT(triggered.slowest, 10ms) << "trigger() must only queue";
 }
 
 TEST(AravisCameraTest, RigOfTwoInProcessFakes) {
@@ -154,23 +113,15 @@ TEST(AravisCameraTest, RigOfTwoInProcessFakes) {
   options.max_skew = 50ms;  // two fakes free-run on their own 40 ms clocks
   auto rig = Rig::create(options, CameraRegistry::instance());
   ASSERT_TRUE(rig.ok()) << rig.error().message;
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::vector<core::FrameSet> sets;  // guarded by mutex
-  ASSERT_TRUE((*rig)
-                  ->start([&](core::FrameSet&& set) {
-                    std::lock_guard lock(mutex);
-                    sets.push_back(std::move(set));
-                    changed.notify_all();
-                  })
-                  .ok());
+  testing_support::Collector<core::FrameSet> collector;
+  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
   constexpr std::size_t kSets = 8;
   for (std::size_t i = 1; i <= kSets; ++i) {
     EXPECT_TRUE((*rig)->trigger(i));
-    std::unique_lock lock(mutex);
-    changed.wait_for(lock, 2s, [&] { return sets.size() >= i; });
+    collector.waitFor(i, 2s);
   }
   (*rig)->stop();
+  const auto sets = collector.take();
   ASSERT_EQ(sets.size(), kSets);
   for (std::size_t i = 0; i < kSets; ++i) {
     EXPECT_EQ(sets[i].trigger_id, i + 1);
@@ -248,77 +199,6 @@ bool triggerIdsFollowFrameIds(const std::vector<Seen>& frames) {
   return true;
 }
 
-// arv-fake-gv-camera-0.8 on the loopback, started per test and killed in teardown.
-class FakeGvCamera {
- public:
-  // The fake binds the GigE Vision control port on lo's 127.0.0.1 (it refuses loopback addresses
-  // that lo does not carry, such as 127.0.0.2): a file lock keeps tests run in parallel (ctest -j)
-  // from starting two at once. Bounded: after kLockWait the test goes on and fails visibly.
-  explicit FakeGvCamera(const std::string& lost_per_thousand = {}) {
-    lock_ = open("/tmp/fieldrig-arv-fake-gv-camera.lock", O_CREAT | O_RDWR | O_CLOEXEC, 0666);
-    const auto deadline = std::chrono::steady_clock::now() + kLockWait;
-    while (lock_ >= 0 && flock(lock_, LOCK_EX | LOCK_NB) != 0 &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(50ms);
-    }
-    std::vector<std::string> args = {FIELDRIG_ARV_FAKE_GV_CAMERA, "-i", "lo"};
-    if (!lost_per_thousand.empty()) {
-      args.push_back("-r");
-      args.push_back(lost_per_thousand);
-    }
-    pid_ = fork();
-    if (pid_ == 0) {
-      std::vector<char*> argv;
-      for (auto& arg : args)
-        argv.push_back(arg.data());
-      argv.push_back(nullptr);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-  }
-  ~FakeGvCamera() {
-    if (pid_ > 0) {
-      kill(pid_, SIGTERM);
-      const auto deadline = std::chrono::steady_clock::now() + 2s;
-      while (waitpid(pid_, nullptr, WNOHANG) == 0) {
-        if (std::chrono::steady_clock::now() > deadline) {
-          kill(pid_, SIGKILL);
-          waitpid(pid_, nullptr, 0);
-          break;
-        }
-        std::this_thread::sleep_for(10ms);
-      }
-    }
-    if (lock_ >= 0)
-      close(lock_);
-  }
-  FakeGvCamera(const FakeGvCamera&) = delete;
-  FakeGvCamera& operator=(const FakeGvCamera&) = delete;
-
-  static constexpr const char* address() { return "127.0.0.1"; }
-  bool running() {
-    if (pid_ > 0 && waitpid(pid_, nullptr, WNOHANG) != 0)
-      pid_ = -1;  // exited (and reaped): nothing to kill in teardown
-    return pid_ > 0;
-  }
-
- private:
-  static constexpr auto kLockWait = 60s;
-  int lock_ = -1;  // closing it releases the lock
-  pid_t pid_ = -1;
-};
-
-// Configures `camera` for the fake, retrying while it starts up (bounded).
-core::Result<bool> configureWhenUp(Camera& camera, const CameraConfig& config, FakeGvCamera& fake) {
-  const auto deadline = std::chrono::steady_clock::now() + 10s;
-  while (true) {
-    auto configured = camera.configure(config);
-    if (configured.ok() || std::chrono::steady_clock::now() > deadline || !fake.running())
-      return configured;
-    std::this_thread::sleep_for(100ms);
-  }
-}
-
 class AravisGigETest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -335,12 +215,13 @@ TEST_F(AravisGigETest, TwoHundredTriggeredFramesNoneLost) {
   ASSERT_TRUE(configured.ok()) << configured.error().message;
   core::FramePool pool(16, std::size_t{kWidth} * kHeight);
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sink()).ok());
+  ASSERT_TRUE(camera->start(pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
   constexpr int kTriggers = 200;
-  const auto slowest = triggerInStep(*camera, collector, kTriggers, 500ms);
+  const auto triggered = triggerInStep(*camera, collector, kTriggers, 500ms);
   camera->stop();
+  EXPECT_EQ(triggered.refused, 0);
 
-  const auto frames = collector.frames();
+  const auto frames = collector.items();
   const AravisStats stats = dynamic_cast<AravisCamera&>(*camera).stats();
   EXPECT_EQ(frames.size(), std::size_t{kTriggers});
   EXPECT_EQ(stats.frames_lost, 0u);
@@ -354,7 +235,7 @@ TEST_F(AravisGigETest, TwoHundredTriggeredFramesNoneLost) {
     }
   }
   EXPECT_TRUE(triggerIdsFollowFrameIds(frames));
-  EXPECT_LT(slowest, 10ms) << "trigger() must not wait for the network";
+  EXPECT_LT(triggered.slowest, 10ms) << "trigger() must not wait for the network";
 }
 
 TEST_F(AravisGigETest, PacketLossIsCountedNeverBlocks) {
@@ -367,14 +248,15 @@ TEST_F(AravisGigETest, PacketLossIsCountedNeverBlocks) {
   ASSERT_TRUE(configured.ok()) << configured.error().message;
   core::FramePool pool(16, std::size_t{64} * 48);
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sink()).ok());
+  ASSERT_TRUE(camera->start(pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
   constexpr int kTriggers = 200;
   const auto started = std::chrono::steady_clock::now();
-  triggerInStep(*camera, collector, kTriggers, 150ms);
+  const auto triggered = triggerInStep(*camera, collector, kTriggers, 150ms);
   camera->stop();
+  EXPECT_EQ(triggered.refused, 0);
   EXPECT_LT(std::chrono::steady_clock::now() - started, 40s);
 
-  const auto frames = collector.frames();
+  const auto frames = collector.items();
   const AravisStats stats = dynamic_cast<AravisCamera&>(*camera).stats();
   // Every trigger is a frame (whole or marked corrupt) or a counted loss.
   EXPECT_EQ(stats.triggers_accepted, std::uint64_t{kTriggers});

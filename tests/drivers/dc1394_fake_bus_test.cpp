@@ -15,6 +15,7 @@
 
 #include "fake_dc1394_bus.h"
 #include "fieldrig/drivers/dc1394/dc1394_camera.h"
+#include "support/collector.h"
 
 namespace fieldrig::drivers {
 namespace {
@@ -25,38 +26,6 @@ using testing::fakeDc1394Bus;
 constexpr std::uint64_t kGuid = 0x00b09d01006fb1a2;
 constexpr std::uint32_t kWidth = 1624;
 constexpr std::uint32_t kHeight = 1224;
-
-// Frames collected on the driver thread; the test thread waits for a count.
-class Frames {
- public:
-  Camera::FrameSink sink() {
-    return [this](core::Frame&& frame) {
-      std::lock_guard lock(mutex_);
-      frames_.push_back(std::move(frame));
-    };
-  }
-  bool waitFor(std::size_t count, std::chrono::milliseconds timeout = 3s) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < deadline) {
-      if (size() >= count)
-        return true;
-      std::this_thread::sleep_for(1ms);
-    }
-    return false;
-  }
-  std::size_t size() {
-    std::lock_guard lock(mutex_);
-    return frames_.size();
-  }
-  std::vector<core::Frame> take() {
-    std::lock_guard lock(mutex_);
-    return std::move(frames_);
-  }
-
- private:
-  std::mutex mutex_;
-  std::vector<core::Frame> frames_;  // guarded by mutex_
-};
 
 class Dc1394FakeBus : public ::testing::Test {
  protected:
@@ -85,7 +54,8 @@ class Dc1394FakeBus : public ::testing::Test {
   }
 
   core::FramePool pool_{8, std::size_t{kWidth} * kHeight};
-  Frames frames_;
+  // Frames collected on the driver thread; the test thread waits (3 s at most) for a count.
+  testing_support::Collector<core::Frame> frames_{3s};
 };
 
 TEST_F(Dc1394FakeBus, ConfiguresFormat7Raw8At1394bS800WithThePlannedPacket) {

@@ -8,7 +8,7 @@
 #include <thread>
 
 #include "fieldrig/sim/test_pattern_source.h"
-#include "support/frame_set_collector.h"
+#include "support/collector.h"
 #include "support/sim_cameras.h"
 
 namespace fieldrig::drivers {
@@ -20,7 +20,41 @@ RigOptions sixCameras(std::uint32_t width = 64, std::uint32_t height = 48) {
   return testing_support::sixSimCameras(width, height);
 }
 
-using Collector = testing_support::FrameSetCollector;
+using Collector = testing_support::Collector<core::FrameSet>;
+
+// Rig tests: most run a rig of sim cameras through a number of triggers and look at the sets.
+class RigTest : public ::testing::Test {
+ protected:
+  // Stopped first, into the live collector (a failed run may leave it running); the sets kept
+  // below then give their buffers back before the rig's pool goes.
+  ~RigTest() override {
+    if (rig_)
+      rig_->stop();
+  }
+
+  // Starts a rig of `options` with the collector as its sink, triggers 1 … `triggers` (`pause`
+  // after each), waits for their sets, stops the rig and keeps the sets in sets_. Its fatal
+  // failures end only this call: call it through ASSERT_NO_FATAL_FAILURE.
+  void run(const RigOptions& options, std::uint64_t triggers,
+           std::chrono::milliseconds pause = std::chrono::milliseconds{0}) {
+    auto rig = Rig::create(options, testing_support::camerasWithSim());
+    ASSERT_TRUE(rig.ok()) << rig.error().message;
+    rig_ = std::move(*rig);
+    ASSERT_TRUE(rig_->start(collector_.sink()).ok());
+    for (std::uint64_t id = 1; id <= triggers; ++id) {
+      ASSERT_TRUE(rig_->trigger(id));
+      if (pause.count() > 0)
+        std::this_thread::sleep_for(pause);
+    }
+    ASSERT_TRUE(collector_.waitFor(triggers));
+    rig_->stop();
+    sets_ = collector_.take();
+  }
+
+  std::unique_ptr<Rig> rig_;
+  Collector collector_;  // keeps every set (and its buffers) until the test lets go
+  std::vector<core::FrameSet> sets_;
+};
 
 bool patternMatches(const core::Frame& frame) {
   const auto& m = frame.metadata;
@@ -36,20 +70,11 @@ bool patternMatches(const core::Frame& frame) {
   return true;
 }
 
-TEST(RigTest, OneWholeSetPerTriggerInOrder) {
+TEST_F(RigTest, OneWholeSetPerTriggerInOrder) {
   RigOptions options = sixCameras();
-  options.pool_sets = 64;  // this test's collector keeps every set (and its buffers) to the end
-  auto rig = Rig::create(options, testing_support::camerasWithSim());
-  ASSERT_TRUE(rig.ok()) << rig.error().message;
-  Collector collector;
-  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
-  for (std::uint64_t id = 1; id <= 50; ++id) {
-    ASSERT_TRUE((*rig)->trigger(id));
-    std::this_thread::sleep_for(1ms);
-  }
-  ASSERT_TRUE(collector.waitFor(50));
-  (*rig)->stop();
-  const auto sets = collector.take();
+  options.pool_sets = 64;  // the collector keeps every set (and its buffers) to the end
+  ASSERT_NO_FATAL_FAILURE(run(options, 50, 1ms));
+  const auto& sets = sets_;
   ASSERT_EQ(sets.size(), 50u);
   for (std::size_t i = 0; i < sets.size(); ++i) {
     EXPECT_EQ(sets[i].trigger_id, i + 1);
@@ -63,24 +88,17 @@ TEST(RigTest, OneWholeSetPerTriggerInOrder) {
   }
   for (const auto& set : sets)
     EXPECT_EQ(set.skew_ns, 0);  // one trigger instant for all six
-  const RigStats stats = (*rig)->stats();
+  const RigStats stats = rig_->stats();
   EXPECT_EQ(stats.sets, 50u);
   EXPECT_EQ(stats.incomplete_sets, 0u);
   EXPECT_EQ(stats.frames_dropped, 0u);
 }
 
-TEST(RigTest, MissingFrameYieldsAnIncompleteSetAfterTheTimeoutWithoutReordering) {
+TEST_F(RigTest, MissingFrameYieldsAnIncompleteSetAfterTheTimeoutWithoutReordering) {
   RigOptions options = sixCameras();
   options.cameras[3].options["drop_every"] = "5";
-  auto rig = Rig::create(options, testing_support::camerasWithSim());
-  ASSERT_TRUE(rig.ok()) << rig.error().message;
-  Collector collector;
-  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
-  for (std::uint64_t id = 1; id <= 12; ++id)
-    ASSERT_TRUE((*rig)->trigger(id));
-  ASSERT_TRUE(collector.waitFor(12));
-  (*rig)->stop();
-  const auto sets = collector.take();
+  ASSERT_NO_FATAL_FAILURE(run(options, 12));
+  const auto& sets = sets_;
   ASSERT_EQ(sets.size(), 12u);
   for (std::size_t i = 0; i < sets.size(); ++i) {
     const std::uint64_t id = i + 1;
@@ -92,68 +110,46 @@ TEST(RigTest, MissingFrameYieldsAnIncompleteSetAfterTheTimeoutWithoutReordering)
       EXPECT_EQ(sets[i].frames[2].metadata.status, core::FrameStatus::kOk);
     }
   }
-  EXPECT_EQ((*rig)->stats().frames_missing, 2u);
-  EXPECT_EQ((*rig)->stats().incomplete_sets, 2u);
+  EXPECT_EQ(rig_->stats().frames_missing, 2u);
+  EXPECT_EQ(rig_->stats().incomplete_sets, 2u);
 }
 
-TEST(RigTest, SkewAboveTheToleranceIsFlagged) {
+TEST_F(RigTest, SkewAboveTheToleranceIsFlagged) {
   RigOptions options = sixCameras();
   options.cameras[5].options["clock_offset_us"] = "300";
-  auto rig = Rig::create(options, testing_support::camerasWithSim());
-  ASSERT_TRUE(rig.ok()) << rig.error().message;
-  Collector collector;
-  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
-  for (std::uint64_t id = 1; id <= 3; ++id)
-    ASSERT_TRUE((*rig)->trigger(id));
-  ASSERT_TRUE(collector.waitFor(3));
-  (*rig)->stop();
+  ASSERT_NO_FATAL_FAILURE(run(options, 3));
   // The rig's trigger is one instant for all sim cameras (a bus broadcast): the skew is exactly
   // the injected 300 µs clock offset.
-  for (const auto& set : collector.take())
+  for (const auto& set : sets_)
     EXPECT_EQ(set.skew_ns, 300'000);
-  EXPECT_EQ((*rig)->stats().skew_flagged, 3u);
-  EXPECT_EQ((*rig)->stats().max_skew_ns, 300'000);
+  EXPECT_EQ(rig_->stats().skew_flagged, 3u);
+  EXPECT_EQ(rig_->stats().max_skew_ns, 300'000);
 }
 
-TEST(RigTest, CorruptFramesAreDeliveredMarked) {
+TEST_F(RigTest, CorruptFramesAreDeliveredMarked) {
   RigOptions options = sixCameras();
   options.cameras[0].options["corrupt_every"] = "2";
-  auto rig = Rig::create(options, testing_support::camerasWithSim());
-  ASSERT_TRUE(rig.ok());
-  Collector collector;
-  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
-  for (std::uint64_t id = 1; id <= 4; ++id)
-    ASSERT_TRUE((*rig)->trigger(id));
-  ASSERT_TRUE(collector.waitFor(4));
-  (*rig)->stop();
-  const auto sets = collector.take();
+  ASSERT_NO_FATAL_FAILURE(run(options, 4));
+  const auto& sets = sets_;
   EXPECT_EQ(sets[1].frames[0].metadata.status, core::FrameStatus::kCorrupt);
   EXPECT_TRUE(sets[1].frames[0].buffer);  // the pixels are kept for inspection
   EXPECT_FALSE(sets[1].complete());
   EXPECT_TRUE(sets[2].complete());
-  EXPECT_EQ((*rig)->stats().frames_corrupt, 2u);
+  EXPECT_EQ(rig_->stats().frames_corrupt, 2u);
 }
 
-TEST(RigTest, BuffersReturnToThePoolWhenConsumersLetGo) {
+TEST_F(RigTest, BuffersReturnToThePoolWhenConsumersLetGo) {
   RigOptions options = sixCameras();
   // Every frame must arrive for the count below: a sim worker starved for 100 ms on a loaded
   // 2-core machine (the test suite runs in parallel) would time its frame out as missing.
   options.frame_timeout = 2s;
-  auto rig = Rig::create(options, testing_support::camerasWithSim());
-  ASSERT_TRUE(rig.ok());
-  Collector collector;
-  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
-  for (std::uint64_t id = 1; id <= 5; ++id)
-    ASSERT_TRUE((*rig)->trigger(id));
-  ASSERT_TRUE(collector.waitFor(5));
-  (*rig)->stop();
-  auto sets = collector.take();
-  EXPECT_EQ((*rig)->pool().available(), (*rig)->pool().capacity() - 30);
-  sets.clear();
-  EXPECT_EQ((*rig)->pool().available(), (*rig)->pool().capacity());
+  ASSERT_NO_FATAL_FAILURE(run(options, 5));
+  EXPECT_EQ(rig_->pool().available(), rig_->pool().capacity() - 30);
+  sets_.clear();
+  EXPECT_EQ(rig_->pool().available(), rig_->pool().capacity());
 }
 
-TEST(RigTest, BuffersReturnEvenWhenTheSinkCopiesTheSet) {
+TEST_F(RigTest, BuffersReturnEvenWhenTheSinkCopiesTheSet) {
   RigOptions options = sixCameras();
   options.pool_sets = 4;  // fewer buffers than triggers: they must come back to be reused
   auto rig = Rig::create(options, testing_support::camerasWithSim());
@@ -183,31 +179,22 @@ TEST(RigTest, BuffersReturnEvenWhenTheSinkCopiesTheSet) {
   EXPECT_EQ((*rig)->pool().available(), (*rig)->pool().capacity());
 }
 
-TEST(RigTest, ExhaustedPoolShowsAsDroppedFrames) {
+TEST_F(RigTest, ExhaustedPoolShowsAsDroppedFrames) {
   RigOptions options = sixCameras();
-  options.pool_sets = 2;  // 12 buffers
-  auto rig = Rig::create(options, testing_support::camerasWithSim());
-  ASSERT_TRUE(rig.ok());
-  Collector collector;  // keeps every set: nothing returns to the pool
-  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
-  for (std::uint64_t id = 1; id <= 4; ++id) {
-    ASSERT_TRUE((*rig)->trigger(id));
-    std::this_thread::sleep_for(5ms);
-  }
-  ASSERT_TRUE(collector.waitFor(4));
-  (*rig)->stop();
-  const auto sets = collector.take();
+  options.pool_sets = 2;  // 12 buffers; the collector keeps every set: nothing returns to the pool
+  ASSERT_NO_FATAL_FAILURE(run(options, 4, 5ms));
+  const auto& sets = sets_;
   EXPECT_TRUE(sets[0].complete());
   EXPECT_TRUE(sets[1].complete());
   for (std::size_t i = 2; i < 4; ++i) {
     for (std::uint32_t c = 0; c < 6; ++c)
       EXPECT_EQ(sets[i].frames[c].metadata.status, core::FrameStatus::kDropped);
   }
-  EXPECT_EQ((*rig)->stats().frames_dropped, 12u);
-  EXPECT_EQ((*rig)->stats().incomplete_sets, 2u);
+  EXPECT_EQ(rig_->stats().frames_dropped, 12u);
+  EXPECT_EQ(rig_->stats().incomplete_sets, 2u);
 }
 
-TEST(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
+TEST_F(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
   RigOptions options = sixCameras();
   options.cameras[4].id = "left";
   auto rig = Rig::create(options, testing_support::camerasWithSim());
@@ -227,7 +214,7 @@ TEST(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
 namespace fieldrig::drivers {
 namespace {
 
-TEST(RigTest, TooManyWaitingSetsLeaveOldestFirstIncomplete) {
+TEST_F(RigTest, TooManyWaitingSetsLeaveOldestFirstIncomplete) {
   RigOptions options = sixCameras(16, 8);
   options.cameras[1].options["drop_every"] = "1";    // camera 1 never delivers
   options.frame_timeout = std::chrono::seconds{30};  // so only the ring's size lets sets go
@@ -265,7 +252,7 @@ TEST(RigTest, TooManyWaitingSetsLeaveOldestFirstIncomplete) {
 namespace fieldrig::drivers {
 namespace {
 
-TEST(RigTest, FramesArrivingShuffledAcrossTriggersAreGroupedRight) {
+TEST_F(RigTest, FramesArrivingShuffledAcrossTriggersAreGroupedRight) {
   RigOptions options = sixCameras();
   // Each camera answers with its own delay: camera 3's frame of trigger 1 arrives after camera
   // 0's frames of triggers 2-6.
@@ -273,17 +260,8 @@ TEST(RigTest, FramesArrivingShuffledAcrossTriggersAreGroupedRight) {
   for (int c = 0; c < 6; ++c)
     options.cameras[c].options["delay_ms"] = std::to_string(delays_ms[c]);
   options.pool_sets = 64;
-  auto rig = Rig::create(options, testing_support::camerasWithSim());
-  ASSERT_TRUE(rig.ok()) << rig.error().message;
-  Collector collector;
-  ASSERT_TRUE((*rig)->start(collector.sink()).ok());
-  for (std::uint64_t id = 1; id <= 30; ++id) {
-    ASSERT_TRUE((*rig)->trigger(id));
-    std::this_thread::sleep_for(5ms);
-  }
-  ASSERT_TRUE(collector.waitFor(30));
-  (*rig)->stop();
-  const auto sets = collector.take();
+  ASSERT_NO_FATAL_FAILURE(run(options, 30, 5ms));
+  const auto& sets = sets_;
   ASSERT_EQ(sets.size(), 30u);
   for (std::size_t i = 0; i < sets.size(); ++i) {
     EXPECT_EQ(sets[i].trigger_id, i + 1);
@@ -291,7 +269,7 @@ TEST(RigTest, FramesArrivingShuffledAcrossTriggersAreGroupedRight) {
     for (std::uint32_t c = 0; c < 6; ++c)
       EXPECT_TRUE(patternMatches(sets[i].frames[c])) << "set " << i << " camera " << c;
   }
-  EXPECT_EQ((*rig)->stats().frames_unexpected, 0u);
+  EXPECT_EQ(rig_->stats().frames_unexpected, 0u);
 }
 
 }  // namespace

@@ -4,13 +4,29 @@
 #include <GeographicLib/Geodesic.hpp>
 
 #include <cmath>
+#include <functional>
 #include <string>
+#include <vector>
+
+#include "support/field_plans.h"
 
 namespace fieldrig::gps {
 namespace {
 
+using testing_support::fieldPlan;
+using testing_support::LatLon;
+
 const GeographicLib::Geodesic& wgs84() {
   return GeographicLib::Geodesic::WGS84();
+}
+
+// `metres` from `start` on the geodesic of `azimuth_deg`, by GeographicLib's Direct: the row ends
+// are computed independently of the code under test.
+LatLon along(LatLon start, double azimuth_deg, double metres) {
+  LatLon end;
+  wgs84().Direct(start.latitude_deg, start.longitude_deg, azimuth_deg, metres, end.latitude_deg,
+                 end.longitude_deg);
+  return end;
 }
 
 double distance(const ImagingLocation& a, const ImagingLocation& b) {
@@ -31,21 +47,13 @@ double angleDifference(double a, double b) {
   return d > 180 ? 360 - d : d;
 }
 
-// A row of ~80 m running roughly north-east near Ames, Iowa: start and end are 80 m apart on
-// the azimuth 40 degrees (the end is computed with GeographicLib's Direct, independently of the
-// code under test).
+// Four rows of ~80 m running roughly north-east near Ames, Iowa: start and end are 80 m apart on
+// the azimuth 40 degrees. Five 10-foot plots (the paper's) from 2 m after the row start, 1 m
+// alleys, 90-inch rows.
 FieldPlan amesPlan() {
-  FieldPlan plan;
-  plan.row_start_latitude_deg = 42.0105;
-  plan.row_start_longitude_deg = -93.7452;
-  wgs84().Direct(plan.row_start_latitude_deg, plan.row_start_longitude_deg, 40.0, 80.0,
-                 plan.row_end_latitude_deg, plan.row_end_longitude_deg);
-  plan.rows = 4;
+  const LatLon start{42.0105, -93.7452};
+  FieldPlan plan = fieldPlan(start, along(start, 40.0, 80.0), 4, 3.048, 2.0);
   plan.plots_per_row = 5;
-  plan.plot_length_m = 3.048;  // 10 feet, the paper's plots
-  plan.alley_length_m = 1.0;
-  plan.row_spacing_m = 2.286;  // 90 inches
-  plan.start_offset_m = 2.0;
   plan.id_prefix = "S1-";
   return plan;
 }
@@ -147,12 +155,8 @@ TEST(FieldPlan, SerpentineHeadings) {
 
 TEST(FieldPlan, HeadingWrapsAroundNorth) {
   // A row driven due south (azimuth 180): the way back is 0, never 360.
-  FieldPlan plan;
-  plan.row_start_latitude_deg = -33.9;
-  plan.row_start_longitude_deg = 18.4;
-  wgs84().Direct(plan.row_start_latitude_deg, plan.row_start_longitude_deg, 180.0, 20.0,
-                 plan.row_end_latitude_deg, plan.row_end_longitude_deg);
-  plan.rows = 2;
+  const LatLon start{-33.9, 18.4};
+  FieldPlan plan = fieldPlan(start, along(start, 180.0, 20.0), 2);
   plan.plots_per_row = 1;
   auto map = generateLocations(plan);
   ASSERT_TRUE(map.ok()) << map.error().message;
@@ -176,13 +180,8 @@ TEST(FieldPlan, AsManyPlotsAsFit) {
 }
 
 TEST(FieldPlan, PlotsFillingTheRowExactlyFit) {
-  FieldPlan plan;
-  plan.row_start_latitude_deg = 10.0;
-  plan.row_start_longitude_deg = 20.0;
-  wgs84().Direct(10.0, 20.0, 90.0, 15.0, plan.row_end_latitude_deg, plan.row_end_longitude_deg);
-  plan.plot_length_m = 4.0;
-  plan.alley_length_m = 1.0;
-  plan.start_offset_m = 0.0;
+  const LatLon start{10.0, 20.0};
+  FieldPlan plan = fieldPlan(start, along(start, 90.0, 15.0), 1, 4.0, 0.0);
   plan.plots_per_row = 3;  // 3 * 4 + 2 * 1 = 14 <= 15
   EXPECT_TRUE(generateLocations(plan).ok());
   plan.start_offset_m = 1.0;  // 15: exactly the row
@@ -197,13 +196,9 @@ TEST(FieldPlan, PlotsFillingTheRowExactlyFit) {
 }
 
 TEST(FieldPlan, IdsPadToTheWidestNumber) {
-  FieldPlan plan;
-  plan.row_start_latitude_deg = 10.0;
-  plan.row_start_longitude_deg = 20.0;
-  wgs84().Direct(10.0, 20.0, 0.0, 500.0, plan.row_end_latitude_deg, plan.row_end_longitude_deg);
-  plan.rows = 101;
+  const LatLon start{10.0, 20.0};
+  FieldPlan plan = fieldPlan(start, along(start, 0.0, 500.0), 101, 1.0);
   plan.plots_per_row = 3;
-  plan.plot_length_m = 1.0;
   plan.alley_length_m = 0.0;
   plan.row_spacing_m = 1.0;
   auto map = generateLocations(plan);
@@ -219,55 +214,53 @@ std::string planError(const FieldPlan& plan) {
   return map.ok() ? std::string() : map.error().message;
 }
 
+// One field of amesPlan() made wrong, and the error it must give: the whole message, or (where
+// the rest quotes computed numbers) how it starts.
+struct WrongField {
+  std::function<void(FieldPlan&)> spoil;
+  std::string message;
+  bool whole = true;
+};
+
 TEST(FieldPlan, ErrorsNameTheField) {
-  FieldPlan plan = amesPlan();
-  plan.rows = 0;
-  EXPECT_EQ(planError(plan), "field plan: field 'rows': must be at least 1, got 0");
-
-  plan = amesPlan();
-  plan.plots_per_row = -1;
-  EXPECT_EQ(planError(plan).rfind("field plan: field 'plots_per_row':", 0), 0u);
-
-  plan = amesPlan();
-  plan.plot_length_m = 0;
-  EXPECT_EQ(planError(plan), "field plan: field 'plot_length_m': must be positive, got 0");
-
-  plan = amesPlan();
-  plan.alley_length_m = -0.5;
-  EXPECT_EQ(planError(plan),
-            "field plan: field 'alley_length_m': must be zero or positive, got -0.5");
-
-  plan = amesPlan();
-  plan.row_spacing_m = 0;
-  EXPECT_EQ(planError(plan), "field plan: field 'row_spacing_m': must be positive, got 0");
-
-  plan = amesPlan();
-  plan.start_offset_m = -1;
-  EXPECT_EQ(planError(plan),
-            "field plan: field 'start_offset_m': must be zero or positive, got -1");
-
-  plan = amesPlan();
-  plan.row_end_latitude_deg = plan.row_start_latitude_deg;
-  plan.row_end_longitude_deg = plan.row_start_longitude_deg;
-  EXPECT_EQ(planError(plan).rfind("field plan: field 'row_end': the row end coincides", 0), 0u);
-
-  plan = amesPlan();
-  plan.row_start_latitude_deg = 91;
-  EXPECT_EQ(planError(plan), "field plan: field 'row_start': latitude 91 is outside [-90, 90]");
-
-  plan = amesPlan();
-  plan.row_end_longitude_deg = std::nan("");
-  EXPECT_EQ(planError(plan).rfind("field plan: field 'row_end': longitude", 0), 0u);
-
-  plan = amesPlan();
-  plan.plots_per_row = 20;  // 1 + 4.048 * 20 = 81.96 > 80
-  EXPECT_EQ(planError(plan).rfind("field plan: field 'plots_per_row': 20 plots need 81.96 m", 0),
-            0u);
-
-  plan = amesPlan();
-  plan.plots_per_row = 0;
-  plan.plot_length_m = 100;
-  EXPECT_EQ(planError(plan).rfind("field plan: field 'plot_length_m': not even one plot", 0), 0u);
+  const std::vector<WrongField> cases{
+      {[](FieldPlan& p) { p.rows = 0; }, "field plan: field 'rows': must be at least 1, got 0"},
+      {[](FieldPlan& p) { p.plots_per_row = -1; }, "field plan: field 'plots_per_row':", false},
+      {[](FieldPlan& p) { p.plot_length_m = 0; },
+       "field plan: field 'plot_length_m': must be positive, got 0"},
+      {[](FieldPlan& p) { p.alley_length_m = -0.5; },
+       "field plan: field 'alley_length_m': must be zero or positive, got -0.5"},
+      {[](FieldPlan& p) { p.row_spacing_m = 0; },
+       "field plan: field 'row_spacing_m': must be positive, got 0"},
+      {[](FieldPlan& p) { p.start_offset_m = -1; },
+       "field plan: field 'start_offset_m': must be zero or positive, got -1"},
+      {[](FieldPlan& p) {
+         p.row_end_latitude_deg = p.row_start_latitude_deg;
+         p.row_end_longitude_deg = p.row_start_longitude_deg;
+       },
+       "field plan: field 'row_end': the row end coincides", false},
+      {[](FieldPlan& p) { p.row_start_latitude_deg = 91; },
+       "field plan: field 'row_start': latitude 91 is outside [-90, 90]"},
+      {[](FieldPlan& p) { p.row_end_longitude_deg = std::nan(""); },
+       "field plan: field 'row_end': longitude", false},
+      {[](FieldPlan& p) { p.plots_per_row = 20; },  // 1 + 4.048 * 20 = 81.96 > 80
+       "field plan: field 'plots_per_row': 20 plots need 81.96 m", false},
+      {[](FieldPlan& p) {
+         p.plots_per_row = 0;
+         p.plot_length_m = 100;
+       },
+       "field plan: field 'plot_length_m': not even one plot", false},
+  };
+  for (const WrongField& wrong : cases) {
+    FieldPlan plan = amesPlan();
+    wrong.spoil(plan);
+    const std::string error = planError(plan);
+    if (wrong.whole) {
+      EXPECT_EQ(error, wrong.message);
+    } else {
+      EXPECT_EQ(error.rfind(wrong.message, 0), 0u) << error;
+    }
+  }
 }
 
 TEST(FieldPlan, GeneratedMapRoundTripsThroughCsv) {

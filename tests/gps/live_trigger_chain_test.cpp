@@ -13,6 +13,7 @@
 #include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/sim/drive_simulator.h"
 #include "fieldrig/sim/trigger_accuracy.h"
+#include "support/field_plans.h"
 
 namespace fieldrig::gps {
 namespace {
@@ -25,14 +26,9 @@ struct TimedLine {
 };
 
 TEST(LiveTriggerChainTest, FiresOnTheSteadyClockAtThePlannedGpsTime) {
-  FieldPlan plan;
-  plan.row_start_latitude_deg = 42.0;
-  plan.row_start_longitude_deg = -93.6;
-  plan.row_end_latitude_deg = 42.0 + 12.0 / 111'000.0;  // about 12 m north
-  plan.row_end_longitude_deg = -93.6;
-  plan.rows = 1;
-  plan.plot_length_m = 2.0;
-  plan.alley_length_m = 1.0;
+  // One row about 12 m north, 2 m plots.
+  const FieldPlan plan =
+      testing_support::fieldPlan({42.0, -93.6}, {42.0 + 12.0 / 111'000.0, -93.6}, 1, 2.0);
   const auto map = generateLocations(plan);
   ASSERT_TRUE(map.ok()) << map.error().message;
   ASSERT_EQ(map->size(), 4u);

@@ -12,10 +12,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using testing_support::readWholeFile;
-using testing_support::ScopedTempDir;
-using testing_support::splitLines;
-using testing_support::SyntheticRig;
+using namespace testing_support;
 
 SessionInfo testInfo(const fs::path& map_file) {
   SessionInfo info;

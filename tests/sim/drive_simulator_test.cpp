@@ -8,22 +8,16 @@
 
 #include "fieldrig/gps/fix_assembler.h"
 #include "fieldrig/gps/nmea_parser.h"
+#include "support/field_plans.h"
 
 namespace fieldrig::sim {
 namespace {
 
+// Three rows of 40 m due north, 8 plots each.
 gps::FieldPlan smallPlan() {
-  gps::FieldPlan plan;
-  plan.row_start_latitude_deg = 42.0;
-  plan.row_start_longitude_deg = -93.6;
-  // 40 m due north.
-  plan.row_end_latitude_deg = 42.0 + 40.0 / 111'034.6;
-  plan.row_end_longitude_deg = -93.6;
-  plan.rows = 3;
+  gps::FieldPlan plan =
+      testing_support::fieldPlan({42.0, -93.6}, {42.0 + 40.0 / 111'034.6, -93.6}, 3);
   plan.plots_per_row = 8;
-  plan.plot_length_m = 3.0;
-  plan.alley_length_m = 1.0;
-  plan.row_spacing_m = 2.286;
   return plan;
 }
 

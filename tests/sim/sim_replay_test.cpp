@@ -16,7 +16,7 @@
 #include "fieldrig/recording/session_reader.h"
 #include "fieldrig/sim/sim_camera.h"
 #include "support/cli_run.h"
-#include "support/frame_set_collector.h"
+#include "support/collector.h"
 #include "support/sim_cameras.h"
 #include "support/temp_dir.h"
 
@@ -73,7 +73,7 @@ RigOptions replayingRig(const std::filesystem::path& session,
   return options;
 }
 
-using Collector = testing_support::FrameSetCollector;
+using Collector = testing_support::Collector<core::FrameSet>;
 
 // Replays the session twice over (the replay wraps around) with trigger ids unlike the
 // recording's, so that a generated pattern could not pass for the recorded pixels, and compares

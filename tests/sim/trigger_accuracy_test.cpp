@@ -9,22 +9,14 @@
 #include "fieldrig/gps/field_plan.h"
 #include "fieldrig/gps/fix_assembler.h"
 #include "fieldrig/gps/trigger_replay.h"
+#include "support/field_plans.h"
 
 namespace fieldrig::sim {
 namespace {
 
+// Six rows of about 33 m, north-north-east.
 gps::FieldPlan fieldPlan() {
-  gps::FieldPlan plan;
-  plan.row_start_latitude_deg = 42.0;
-  plan.row_start_longitude_deg = -93.6;
-  plan.row_end_latitude_deg = 42.0003;  // about 33 m, north-north-east
-  plan.row_end_longitude_deg = -93.59985;
-  plan.rows = 6;
-  plan.plot_length_m = 3.0;
-  plan.alley_length_m = 1.0;
-  plan.row_spacing_m = 2.286;
-  plan.start_offset_m = 0.5;
-  return plan;
+  return testing_support::fieldPlan({42.0, -93.6}, {42.0003, -93.59985}, 6, 3.0, 0.5);
 }
 
 struct ReplayRun {

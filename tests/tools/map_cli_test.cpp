@@ -24,6 +24,7 @@
 #include "fieldrig/gps/nmea_parser.h"
 #include "support/cli_process.h"
 #include "support/cli_run.h"
+#include "support/field_plans.h"
 #include "support/socat_pty.h"
 #include "support/temp_dir.h"
 
@@ -130,30 +131,15 @@ void writeFile(const std::string& path, const std::string& text) {
 
 TEST(MapCli, GenerateWritesTheFieldPlansMap) {
   const ScopedTempDir dir("map_cli_generate");
-  const auto run = runFieldrig({"map",
-                                "generate",
-                                "--row-start",
-                                "42.0105,-93.7452",
-                                "--row-end",
-                                "42.0110,-93.7445",
-                                "--rows",
-                                "3",
-                                "--plots",
-                                "4",
-                                "--plot-length",
-                                "3.048",
-                                "--alley-length",
-                                "1.0",
-                                "--row-spacing",
-                                "2.286",
-                                "--start-offset",
-                                "0.5",
-                                "--left",
-                                "--id-prefix",
-                                "T",
-                                "--out",
-                                dir / "map.csv"},
-                               dir.path());
+  // Three rows of four 10-foot plots, further rows to the left, ids T…: every option given.
+  gps::FieldPlan plan =
+      testing_support::fieldPlan({42.0105, -93.7452}, {42.0110, -93.7445}, 3, 3.048, 0.5);
+  plan.plots_per_row = 4;
+  plan.rows_to_the_right = false;
+  plan.id_prefix = "T";
+  const auto run = runFieldrig(
+      testing_support::withFieldPlan({"map", "generate"}, plan, {"--out", dir / "map.csv"}),
+      dir.path());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   ASSERT_EQ(run.out_lines.size(), 1u) << run.err;
   const Json summary = Json::parse(run.out_lines[0]);
@@ -161,19 +147,6 @@ TEST(MapCli, GenerateWritesTheFieldPlansMap) {
   EXPECT_EQ(summary["rows"], 3);
   EXPECT_EQ(summary["plots_per_row"], 4);
 
-  gps::FieldPlan plan;
-  plan.row_start_latitude_deg = 42.0105;
-  plan.row_start_longitude_deg = -93.7452;
-  plan.row_end_latitude_deg = 42.0110;
-  plan.row_end_longitude_deg = -93.7445;
-  plan.rows = 3;
-  plan.plots_per_row = 4;
-  plan.plot_length_m = 3.048;
-  plan.alley_length_m = 1.0;
-  plan.row_spacing_m = 2.286;
-  plan.start_offset_m = 0.5;
-  plan.rows_to_the_right = false;
-  plan.id_prefix = "T";
   auto expected = gps::generateLocations(plan);
   ASSERT_TRUE(expected.ok()) << expected.error().message;
   auto written = gps::LocationMap::load(dir / "map.csv");

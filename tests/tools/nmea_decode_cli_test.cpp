@@ -22,9 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 using gps::withChecksum;
-using testing_support::CliRun;
-using testing_support::readWholeFile;
-using testing_support::ScopedTempDir;
+using namespace testing_support;
 
 const fs::path kGpsdDir = fs::path(FIELDRIG_SHARED_DATA_DIR) / "nmea" / "gpsd";
 
@@ -84,6 +82,19 @@ std::vector<Json> checkContract(const CliRun& run, Json& summary) {
     objects.push_back(line);
   }
   return objects;
+}
+
+// `text` as the file NAME.nmea in a fresh folder, decoded there: it must exit 0 with every line
+// by the contract. The objects, and the summary in `summary`. Its fatal failures end only this
+// call: call it through ASSERT_NO_FATAL_FAILURE.
+void decodeText(const std::string& name, const std::string& text, std::vector<Json>& objects,
+                Json& summary) {
+  const ScopedTempDir dir("nmea_decode_cli_" + name);
+  const fs::path file = dir / (name + ".nmea");
+  std::ofstream(file, std::ios::binary) << text;
+  const CliRun run = decode(file, dir);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  objects = checkContract(run, summary);
 }
 
 // hh:mm:ss of an output object, to compare order with the input.
@@ -170,14 +181,9 @@ TEST(NmeaDecodeCli, CorruptLinesNeverYieldAnObject) {
       "\r\n" + wrong_checksum + "\r\n" + bad_gga.substr(0, 40) + "\r\n" + nul_inside + "\r\n" +
       "$GNGGA,120000" + good_rmc + "\r\n" + flipped + "\r\n" + "line noise \x01\x02\r\n" +
       "$GPTXT," + std::string(400, 'x') + "\r\n" + good_gga;  // no final terminator
-  const ScopedTempDir dir("nmea_decode_cli_corrupt");
-  const fs::path file = dir / "corrupt.nmea";
-  std::ofstream(file, std::ios::binary) << file_text;
-
-  const CliRun run = decode(file, dir);
-  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::vector<Json> objects;
   Json summary;
-  const std::vector<Json> objects = checkContract(run, summary);
+  ASSERT_NO_FATAL_FAILURE(decodeText("corrupt", file_text, objects, summary));
   ASSERT_EQ(objects.size(), 4u);
   const std::vector<std::string> order = {"RMC", "GGA", "RMC", "GGA"};
   for (std::size_t i = 0; i < objects.size(); ++i) {
@@ -217,13 +223,9 @@ TEST(NmeaDecodeCli, TimesKeepTheReceiversPrecisionAndValidIsStatusA) {
       "\r\n" +
       withChecksum("GPGGA,235959.125,4000.12345678,N,08800.12345678,W,1,08,1.0,10.0,M,0,M,,") +
       "\r\n" + withChecksum("GPRMC,000000.00,V,,,,,,,010127,,,N") + "\r\n";
-  const ScopedTempDir dir("nmea_decode_cli_precision");
-  const fs::path file = dir / "precision.nmea";
-  std::ofstream(file, std::ios::binary) << file_text;
-  const CliRun run = decode(file, dir);
-  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::vector<Json> objects;
   Json summary;
-  const std::vector<Json> objects = checkContract(run, summary);
+  ASSERT_NO_FATAL_FAILURE(decodeText("precision", file_text, objects, summary));
   ASSERT_EQ(objects.size(), 3u);
   EXPECT_EQ(objects[0]["time"], "2026-12-31T23:59:59.125Z");
   EXPECT_EQ(objects[0]["valid"], true);

@@ -12,11 +12,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using testing_support::readWholeFile;
-using testing_support::runFieldrig;
-using testing_support::ScopedTempDir;
-using testing_support::splitLines;
-using testing_support::SyntheticRig;
+using namespace testing_support;
 
 void writeSession(const fs::path& session) {
   SessionWriter writer;

@@ -6,6 +6,8 @@
 
 #include "fieldrig/gps/location_map.h"
 #include "support/cli_run.h"
+#include "support/field_plans.h"
+#include "support/temp_dir.h"
 
 namespace fieldrig {
 namespace {
@@ -13,46 +15,25 @@ namespace {
 namespace fs = std::filesystem;
 using testing_support::readWholeFile;
 using testing_support::runFieldrig;
+using testing_support::withFieldPlan;
 
 class SimCliTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(::testing::TempDir()) / ("sim_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  const testing_support::ScopedTempDir temp_{"sim_cli"};
+  const fs::path dir_ = temp_.path();
 };
 
 TEST_F(SimCliTest, ReproducesTheBundledDemoData) {
   const fs::path demo = fs::path(FIELDRIG_SOURCE_DIR) / "sim" / "data";
-  const auto run = runFieldrig({"sim",
-                                "drive",
-                                "--row-start",
-                                "42.0106,-93.7385",
-                                "--row-end",
-                                "42.0112,-93.7385",
-                                "--rows",
-                                "8",
-                                "--plot-length",
-                                "3",
-                                "--alley-length",
-                                "1",
-                                "--row-spacing",
-                                "2.286",
-                                "--start-offset",
-                                "1",
-                                "--speed",
-                                "2",
-                                "--seed",
-                                "2026",
-                                "--start",
-                                "2026-07-14T15:30:00Z",
-                                "--out-nmea",
-                                (dir_ / "drive.nmea").string(),
-                                "--out-map",
-                                (dir_ / "map.csv").string()},
-                               dir_);
+  // Eight rows of about 67 m north, 3 m plots from 1 m after the row start: sim/data's field.
+  const gps::FieldPlan demo_plan =
+      testing_support::fieldPlan({42.0106, -93.7385}, {42.0112, -93.7385}, 8, 3.0, 1.0);
+  const auto run = runFieldrig(
+      withFieldPlan(
+          {"sim", "drive"}, demo_plan,
+          {"--speed", "2", "--seed", "2026", "--start", "2026-07-14T15:30:00Z", "--out-nmea",
+           (dir_ / "drive.nmea").string(), "--out-map", (dir_ / "map.csv").string()}),
+      dir_);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(readWholeFile(dir_ / "drive.nmea"), readWholeFile(demo / "demo_drive.nmea"));
   EXPECT_EQ(readWholeFile(dir_ / "map.csv"), readWholeFile(demo / "demo_map.csv"));

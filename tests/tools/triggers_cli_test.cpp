@@ -13,6 +13,8 @@
 #include "fieldrig/sim/drive_simulator.h"
 #include "fieldrig/sim/trigger_accuracy.h"
 #include "support/cli_run.h"
+#include "support/field_plans.h"
+#include "support/temp_dir.h"
 
 namespace fieldrig {
 namespace {
@@ -24,30 +26,21 @@ using testing_support::runFieldrig;
 class TriggersCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(::testing::TempDir()) / ("triggers_cli_" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    plan_.row_start_latitude_deg = 41.99;
-    plan_.row_start_longitude_deg = -93.64;
-    plan_.row_end_latitude_deg = 41.9903;
-    plan_.row_end_longitude_deg = -93.6399;
-    plan_.rows = 4;
-    plan_.plot_length_m = 3.0;
-    plan_.alley_length_m = 1.0;
-    plan_.start_offset_m = 0.5;
     const auto map = gps::generateLocations(plan_);
     ASSERT_TRUE(map.ok()) << map.error().message;
     map_ = *map;
     ASSERT_TRUE(map_.save(dir_ / "map.csv").ok());
   }
-  void TearDown() override { fs::remove_all(dir_); }
-
   void write(const fs::path& path, const std::string& text) {
     std::ofstream out(path, std::ios::binary);
     out << text;
   }
 
-  fs::path dir_;
-  gps::FieldPlan plan_;
+  const testing_support::ScopedTempDir temp_{"triggers_cli"};
+  const fs::path dir_ = temp_.path();
+  // Four rows of about 35 m, north-north-east.
+  const gps::FieldPlan plan_ =
+      testing_support::fieldPlan({41.99, -93.64}, {41.9903, -93.6399}, 4, 3.0, 0.5);
   gps::LocationMap map_;
 };
 

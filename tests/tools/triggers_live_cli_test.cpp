@@ -10,6 +10,7 @@
 #include "fieldrig/sim/trigger_accuracy.h"
 #include "support/cli_process.h"
 #include "support/cli_run.h"
+#include "support/field_plans.h"
 #include "support/socat_pty.h"
 #include "support/temp_dir.h"
 
@@ -22,14 +23,9 @@ using Json = nlohmann::json;
 
 TEST(TriggersLiveCliTest, FiresEveryLocationOnceFromASerialDevice) {
   const testing_support::ScopedTempDir dir("triggers_live");
-  gps::FieldPlan plan;
-  plan.row_start_latitude_deg = 41.99;
-  plan.row_start_longitude_deg = -93.64;
-  plan.row_end_latitude_deg = 41.99 + 10.0 / 111'000.0;
-  plan.row_end_longitude_deg = -93.64;
-  plan.rows = 2;
-  plan.plot_length_m = 2.0;
-  plan.alley_length_m = 1.0;
+  // Two rows about 10 m long, 2 m plots.
+  const gps::FieldPlan plan =
+      testing_support::fieldPlan({41.99, -93.64}, {41.99 + 10.0 / 111'000.0, -93.64}, 2, 2.0);
   const auto map = gps::generateLocations(plan);
   ASSERT_TRUE(map.ok()) << map.error().message;
   ASSERT_TRUE(map->save(dir / "map.csv").ok());
