@@ -1,6 +1,5 @@
 // `fieldrig session info DIR [--verify]`: one JSON summary of a recorded session; with --verify
 // every indexed frame is read back and checked, and damage makes the exit code non-zero.
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -11,29 +10,12 @@
 namespace fieldrig::tools {
 namespace {
 
-namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
 struct InfoArgs {
   std::string dir;
   bool verify = false;
 };
-
-// Bytes of every regular file in the session folder, recursively.
-std::uint64_t folderBytes(const fs::path& dir) {
-  std::uint64_t bytes = 0;
-  std::error_code ec;
-  for (auto it = fs::recursive_directory_iterator(dir, ec);
-       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
-    std::error_code size_ec;
-    if (it->is_regular_file(size_ec)) {
-      const std::uintmax_t size = it->file_size(size_ec);
-      if (!size_ec)
-        bytes += size;
-    }
-  }
-  return bytes;
-}
 
 int runInfo(const InfoArgs& args) {
   core::Result<recording::SessionReader> opened = recording::SessionReader::open(args.dir);
@@ -42,25 +24,16 @@ int runInfo(const InfoArgs& args) {
     return kExitBadInput;
   }
   const recording::SessionReader& reader = *opened;
-  std::uint64_t frames = 0;
-  std::uint64_t frames_not_ok = 0;
-  std::uint64_t complete = 0;
-  for (const recording::IndexedSet& set : reader.sets()) {
-    complete += set.complete ? 1 : 0;
-    for (const recording::IndexedFrame& frame : set.frames) {
-      ++frames;
-      frames_not_ok += frame.status == recording::FrameStatus::kOk ? 0 : 1;
-    }
-  }
+  const recording::SessionCounts counts = reader.counts();
   Json out;
   out["dir"] = args.dir;
   out["software_version"] = reader.metadata().software_version;
   out["start_time"] = reader.metadata().start_time;
-  out["sets"] = reader.sets().size();
-  out["frames"] = frames;
-  out["frames_not_ok"] = frames_not_ok;
-  out["complete"] = complete;
-  out["incomplete"] = reader.sets().size() - complete;
+  out["sets"] = counts.sets;
+  out["frames"] = counts.frames;
+  out["frames_not_ok"] = counts.frames_not_ok;
+  out["complete"] = counts.complete_sets;
+  out["incomplete"] = counts.sets - counts.complete_sets;
   out["first_trigger_time"] =
       reader.sets().empty() ? Json(nullptr)
                             : Json(core::formatIso8601(reader.sets().front().trigger_time, 3));
@@ -72,7 +45,7 @@ int runInfo(const InfoArgs& args) {
   } else {
     out["torn_line"] = nullptr;
   }
-  out["bytes"] = folderBytes(args.dir);
+  out["bytes"] = reader.bytesOnDisk();
 
   int exit_code = kExitOk;
   if (args.verify) {
