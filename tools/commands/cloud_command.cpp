@@ -16,7 +16,6 @@
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/recording/session_reader.h"
-#include "fieldrig/stereo/preprocess.h"
 
 namespace fieldrig::tools {
 namespace {
@@ -63,39 +62,21 @@ int runCloud(const CloudArgs& args) {
     std::cerr << who << rig.error().message << '\n';
     return kExitBadInput;
   }
+  const std::vector<std::string> files = splitCommas(args.pairs);
+  if (!reader && files.size() != 2 * rig->heads.size()) {
+    std::cerr << who << "--pairs names " << files.size() << " files; the rig in "
+              << (std::filesystem::path(args.calib) / "rig.yml").string() << " has "
+              << rig->heads.size() << " heads, so " << 2 * rig->heads.size()
+              << " are needed (L1,R1,L2,R2,…)\n";
+    return kExitBadInput;
+  }
   std::vector<std::string> problems;
-  std::vector<cloud::HeadFrames> frames;
-  if (reader) {
-    auto loaded = daemon::headFramesFromRecording(*reader, static_cast<std::uint64_t>(args.set),
-                                                  *rig, problems);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
-    frames = std::move(*loaded);
-  } else {
-    const std::vector<std::string> files = splitCommas(args.pairs);
-    if (files.size() != 2 * rig->heads.size()) {
-      std::cerr << who << "--pairs names " << files.size() << " files; the rig in "
-                << (std::filesystem::path(args.calib) / "rig.yml").string() << " has "
-                << rig->heads.size() << " heads, so " << 2 * rig->heads.size()
-                << " are needed (L1,R1,L2,R2,…)\n";
-      return kExitBadInput;
-    }
-    for (std::size_t i = 0; i < rig->heads.size(); ++i) {
-      cloud::HeadFrames head;
-      head.pixel_format = rig->pixel_format;
-      for (const auto& [file, image] :
-           {std::pair{&files[2 * i], &head.left}, std::pair{&files[2 * i + 1], &head.right}}) {
-        core::Result<cv::Mat> read = stereo::readFrameImage(*file);
-        if (!read) {
-          std::cerr << who << read.error().message << '\n';
-          return kExitBadInput;
-        }
-        *image = std::move(*read);
-      }
-      frames.push_back(std::move(head));
-    }
+  const auto frames = reader ? daemon::headFramesFromRecording(
+                                   *reader, static_cast<std::uint64_t>(args.set), *rig, problems)
+                             : daemon::headFramesFromImageFiles(files, *rig);
+  if (!frames) {
+    std::cerr << who << frames.error().message << '\n';
+    return kExitBadInput;
   }
   cloud::CloudOptions options;
   options.matcher.wls = args.wls;
@@ -104,7 +85,7 @@ int runCloud(const CloudArgs& args) {
     std::cerr << who << builder.error().message << '\n';
     return kExitBadInput;
   }
-  const cloud::FusionResult result = builder->build(frames);
+  const cloud::FusionResult result = builder->build(*frames);
   Json heads = Json::array();
   for (const cloud::HeadStatus& head : result.heads) {
     Json h;

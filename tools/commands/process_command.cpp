@@ -1,10 +1,9 @@
 // `fieldrig process SESSION [--calib DIR] [--map MAP.csv] [--config FILE] [--traits-config FILE]
 //  [--out DIR] [--shard K/N] [--force] [--clouds]`: every FrameSet of a recorded session through
-//  the plot
-// processor, the daemon's own (daemon/session_processing.h), into the results folder (plots.jsonl,
-// plots.csv, plots.geojson; daemon/results_writer.h), one JSON line per set on stdout and a summary
-// line last. It resumes: sets already in the folder's plots.jsonl (by trigger id) are skipped
-// unless --force.
+// the plot processor, the daemon's own (daemon/session_processing.h), into the results folder
+// (plots.jsonl, plots.csv, plots.geojson; daemon/results_writer.h), one JSON line per set on stdout
+// and a summary line last. It resumes: sets already in the folder's plots.jsonl (by trigger id) are
+// skipped unless --force.
 #include <charconv>
 #include <filesystem>
 #include <iostream>
@@ -96,16 +95,10 @@ int runProcess(const ProcessArgs& args) {
     std::cerr << who << processor.error().message << '\n';
     return kExitBadInput;
   }
-  fs::path out_dir = args.out.empty() ? reader.dir() / "results" : fs::path(args.out);
-  if (args.out.empty() && run.shard_count > 1) {  // shards never write the same file
-    out_dir /=
-        "shard-" + std::to_string(run.shard_index) + "-of-" + std::to_string(run.shard_count);
-  }
-  if (args.force) {
-    std::error_code ec;
-    for (const char* name : {"plots.jsonl", "plots.csv", "plots.geojson"})
-      fs::remove(out_dir / name, ec);
-  }
+  const fs::path out_dir =
+      args.out.empty() ? daemon::defaultResultsDir(reader.dir(), run) : fs::path(args.out);
+  if (args.force)
+    daemon::removeResults(out_dir);
   auto results = daemon::ResultsWriter::open(out_dir);
   if (!results) {
     std::cerr << who << results.error().message << '\n';
@@ -128,9 +121,10 @@ int runProcess(const ProcessArgs& args) {
   summary["unplaced"] = done->unplaced;
   summary["already_done"] = done->already_done;
   summary["plots_in_results"] = (*results)->plots();
-  summary["csv"] = (out_dir / "plots.csv").string();
-  summary["geojson"] = (out_dir / "plots.geojson").string();
-  summary["jsonl"] = (out_dir / "plots.jsonl").string();
+  const daemon::ResultsFiles files = daemon::resultsFiles(out_dir);
+  summary["csv"] = files.csv.string();
+  summary["geojson"] = files.geojson.string();
+  summary["jsonl"] = files.jsonl.string();
   std::cout << Json{{"summary", summary}}.dump() << std::endl;
   return kExitOk;
 }
