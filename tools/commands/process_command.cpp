@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/config/config.h"
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/daemon/results_writer.h"
@@ -52,68 +52,52 @@ int runProcess(const ProcessArgs& args) {
     return kExitBadInput;
   }
   auto opened = recording::SessionReader::open(args.session);
-  if (!opened) {
-    std::cerr << who << opened.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!opened)
+    return fail(who, opened.error().message);
   const recording::SessionReader& reader = *opened;
   auto rig = daemon::loadRigFor(args.calib, &reader);
-  if (!rig) {
-    std::cerr << who << rig.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!rig)
+    return fail(who, rig.error().message);
   pipeline::ProcessorOptions options;
   options.keep_cloud = args.clouds;
   if (!args.config.empty()) {  // the daemon's file: its processing options, nothing else
     auto loaded = config::loadConfig(args.config);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!loaded)
+      return fail(who, loaded.error().message);
     options.cloud = loaded->pipeline.cloud;
     options.traits = loaded->pipeline.traits;
   }
   if (!args.traits_config.empty()) {  // overrides the configuration's traits
     auto loaded = config::loadTraitsOptions(args.traits_config);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!loaded)
+      return fail(who, loaded.error().message);
     options.traits = *loaded;
   }
   std::optional<gps::LocationMap> map;
   if (!args.map.empty()) {
     auto loaded = gps::LocationMap::load(args.map);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!loaded)
+      return fail(who, loaded.error().message);
     map = std::move(*loaded);
   }
   auto processor = pipeline::PlotProcessor::create(*rig, options);
-  if (!processor) {
-    std::cerr << who << processor.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!processor)
+    return fail(who, processor.error().message);
   const fs::path out_dir =
       args.out.empty() ? daemon::defaultResultsDir(reader.dir(), run) : fs::path(args.out);
   if (args.force)
     daemon::removeResults(out_dir);
   auto results = daemon::ResultsWriter::open(out_dir);
-  if (!results) {
-    std::cerr << who << results.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!results)
+    return fail(who, results.error().message);
   if (args.clouds)
     run.clouds_dir = out_dir;
   auto done = daemon::processSession(
       reader, *processor, map ? &*map : nullptr, **results, run,
       [](const Json& line) { std::cout << line.dump() << std::endl; },
       [who](const std::string& problem) { std::cerr << who << problem << '\n'; });
-  if (!done) {
-    std::cerr << who << done.error().message << '\n';
-    return kExitRuntime;
-  }
+  if (!done)
+    return fail(who, done.error().message, kExitRuntime);
   Json summary;
   summary["sets"] = done->sets;
   summary["ok"] = done->ok;
@@ -132,9 +116,9 @@ int runProcess(const ProcessArgs& args) {
 }  // namespace
 
 void registerProcessCommand(CLI::App& app, int& exit_code) {
-  auto args = std::make_shared<ProcessArgs>();
-  CLI::App* process = app.add_subcommand(
-      "process", "Every FrameSet of a session → fused cloud → plot traits (CSV and GeoJSON)");
+  const auto [process, args] = addSubcommand(
+      app, "process", "Every FrameSet of a session → fused cloud → plot traits (CSV and GeoJSON)",
+      exit_code, runProcess);
   process->add_option("session", args->session, "Session folder")->required();
   process->add_option("--calib", args->calib,
                       "Calibration folder (rig.yml + one folder per head); default: the "
@@ -156,7 +140,6 @@ void registerProcessCommand(CLI::App& app, int& exit_code) {
                     "Process every set again (default: resume, skipping the sets already in the "
                     "results)");
   process->add_flag("--clouds", args->clouds, "Also write each set's fused cloud as PLY");
-  process->callback([args, &exit_code] { exit_code = runProcess(*args); });
 }
 
 }  // namespace fieldrig::tools

@@ -4,7 +4,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/recording/session_reader.h"
 
 namespace fieldrig::tools {
@@ -19,10 +19,8 @@ struct InfoArgs {
 
 int runInfo(const InfoArgs& args) {
   core::Result<recording::SessionReader> opened = recording::SessionReader::open(args.dir);
-  if (!opened) {
-    std::cerr << "fieldrig session info: " << opened.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!opened)
+    return fail("fieldrig session info: ", opened.error().message);
   const recording::SessionReader& reader = *opened;
   const recording::SessionCounts counts = reader.counts();
   Json out;
@@ -66,15 +64,13 @@ int runInfo(const InfoArgs& args) {
 }  // namespace
 
 void registerSessionCommand(CLI::App& app, int& exit_code) {
-  CLI::App* session = app.add_subcommand("session", "Recorded sessions");
-  session->require_subcommand(1);
-  CLI::App* info = session->add_subcommand(
-      "info", "Print a session's summary as one JSON line; --verify checks every frame");
-  auto args = std::make_shared<InfoArgs>();
+  CLI::App* session = addCommandGroup(app, "session", "Recorded sessions");
+  const auto [info, args] = addSubcommand(
+      *session, "info", "Print a session's summary as one JSON line; --verify checks every frame",
+      exit_code, runInfo);
   info->add_option("dir", args->dir, "Session folder")->required();
   info->add_flag("--verify", args->verify,
                  "Read every indexed frame back: size, PGM header and CRC-32; exit 3 on damage");
-  info->callback([args, &exit_code] { exit_code = runInfo(*args); });
 }
 
 }  // namespace fieldrig::tools
