@@ -623,7 +623,8 @@ void readMatcher(const Value& section, stereo::MatcherOptions& o) {
           });
 }
 
-// The traits keys: the field names, as traits::traitsOptionsFromJson has read them from JSON.
+// The traits keys: the field names, as the JSON loader of earlier versions read them, so that
+// their traits files still load.
 void readTraits(const Value& section, traits::TraitsOptions& o) {
   const Entries entries = readMap(
       section,

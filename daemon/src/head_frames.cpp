@@ -4,6 +4,7 @@
 #include <span>
 
 #include "fieldrig/core/rig_layout.h"
+#include "fieldrig/stereo/preprocess.h"
 
 namespace fieldrig::daemon {
 namespace {
@@ -54,6 +55,29 @@ core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
     image = cv::Mat(loaded->height, loaded->width, CV_8UC1, loaded->pixels.data()).clone();
     format = it->pixel_format;
   });
+}
+
+core::Result<std::vector<cloud::HeadFrames>> headFramesFromImageFiles(
+    const std::vector<std::string>& files, const cloud::RigCalibration& rig) {
+  if (files.size() != 2 * rig.heads.size()) {
+    return core::Error{std::to_string(files.size()) + " image files for a rig of " +
+                       std::to_string(rig.heads.size()) + " heads, which needs " +
+                       std::to_string(2 * rig.heads.size())};
+  }
+  std::vector<cloud::HeadFrames> frames;
+  for (std::size_t i = 0; i < rig.heads.size(); ++i) {
+    cloud::HeadFrames head;
+    head.pixel_format = rig.pixel_format;
+    for (const auto& [file, image] :
+         {std::pair{&files[2 * i], &head.left}, std::pair{&files[2 * i + 1], &head.right}}) {
+      core::Result<cv::Mat> read = stereo::readFrameImage(*file);
+      if (!read)
+        return read.error();
+      *image = std::move(*read);
+    }
+    frames.push_back(std::move(head));
+  }
+  return frames;
 }
 
 std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,

@@ -8,13 +8,23 @@ namespace fieldrig::daemon {
 namespace {
 
 using Json = nlohmann::ordered_json;
-constexpr const char* kLinesFile = "plots.jsonl";
 
 Json optionalJson(const std::optional<std::string>& value) {
   return value ? Json(*value) : Json(nullptr);
 }
 
 }  // namespace
+
+ResultsFiles resultsFiles(const std::filesystem::path& dir) {
+  return {dir / "plots.jsonl", dir / "plots.csv", dir / "plots.geojson"};
+}
+
+void removeResults(const std::filesystem::path& dir) {
+  const ResultsFiles files = resultsFiles(dir);
+  std::error_code ec;  // a file that is not there is already removed
+  for (const std::filesystem::path& file : {files.jsonl, files.csv, files.geojson})
+    std::filesystem::remove(file, ec);
+}
 
 std::optional<std::pair<double, double>> plotPosition(const std::optional<std::string>& location_id,
                                                       const std::optional<core::GpsFix>& fix,
@@ -65,7 +75,7 @@ core::Result<std::unique_ptr<ResultsWriter>> ResultsWriter::open(const std::file
   if (ec)
     return core::Error{dir.string() + ": cannot create folder: " + ec.message()};
   std::unique_ptr<ResultsWriter> writer(new ResultsWriter(dir, options));
-  const std::filesystem::path lines_path = dir / kLinesFile;
+  const std::filesystem::path lines_path = resultsFiles(dir).jsonl;
   if (!std::filesystem::exists(lines_path))
     return writer;
   std::string error;
@@ -111,7 +121,7 @@ ResultsWriter::~ResultsWriter() {
 
 std::string ResultsWriter::add(const nlohmann::ordered_json& line) {
   if (options_.jsonl) {
-    if (std::string failed = core::appendDurably(dir_ / kLinesFile, line.dump() + "\n");
+    if (std::string failed = core::appendDurably(resultsFiles(dir_).jsonl, line.dump() + "\n");
         !failed.empty()) {
       return failed;
     }
@@ -138,14 +148,14 @@ std::string ResultsWriter::writeTables() {
   tables_stale_ = false;
   if (options_.csv) {
     if (std::string failed =
-            core::replaceFileAtomically(dir_ / "plots.csv", traits::formatCsv(rows_));
+            core::replaceFileAtomically(resultsFiles(dir_).csv, traits::formatCsv(rows_));
         !failed.empty()) {
       return failed;
     }
   }
   if (options_.geojson) {
     if (std::string failed =
-            core::replaceFileAtomically(dir_ / "plots.geojson", traits::formatGeoJson(rows_));
+            core::replaceFileAtomically(resultsFiles(dir_).geojson, traits::formatGeoJson(rows_));
         !failed.empty()) {
       return failed;
     }

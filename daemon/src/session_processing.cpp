@@ -5,6 +5,16 @@
 
 namespace fieldrig::daemon {
 
+std::filesystem::path defaultResultsDir(const std::filesystem::path& session_dir,
+                                        const SessionProcessingOptions& options) {
+  std::filesystem::path dir = session_dir / "results";
+  if (options.shard_count > 1) {
+    dir /= "shard-" + std::to_string(options.shard_index) + "-of-" +
+           std::to_string(options.shard_count);
+  }
+  return dir;
+}
+
 core::Result<SessionProcessingSummary> processSession(
     const recording::SessionReader& reader, pipeline::PlotProcessor& processor,
     const gps::LocationMap* map, ResultsWriter& results, const SessionProcessingOptions& options,

@@ -97,6 +97,33 @@ std::vector<const IndexedSet*> SessionReader::byLocationId(std::string_view loca
   return found;
 }
 
+SessionCounts SessionReader::counts() const {
+  SessionCounts counts;
+  counts.sets = sets_.size();
+  for (const IndexedSet& set : sets_) {
+    counts.complete_sets += set.complete ? 1 : 0;
+    counts.frames += set.frames.size();
+    for (const IndexedFrame& frame : set.frames)
+      counts.frames_not_ok += frame.status == FrameStatus::kOk ? 0 : 1;
+  }
+  return counts;
+}
+
+std::uint64_t SessionReader::bytesOnDisk() const {
+  std::uint64_t bytes = 0;
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir_, ec);
+       !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+    std::error_code size_ec;
+    if (it->is_regular_file(size_ec)) {
+      const std::uintmax_t size = it->file_size(size_ec);
+      if (!size_ec)
+        bytes += size;
+    }
+  }
+  return bytes;
+}
+
 core::Result<Image> SessionReader::loadFrame(const IndexedFrame& frame) const {
   if (frame.file.empty())
     return core::Error{"camera " + std::to_string(frame.camera_index) + " (" + frame.camera_name +

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/daemon/acquisition.h"
 #include "fieldrig/recording/session_format.h"
 #include "fieldrig/sim/sim_camera.h"
@@ -59,23 +59,18 @@ int runAcquire(const AcquireArgs& args) {
   options.rig.frame_timeout = std::chrono::milliseconds{args.frame_timeout_ms};
   const auto format = core::parsePixelFormat(args.pixel_format);
   if (!format) {
-    std::cerr << kName << "--pixel-format: '" << args.pixel_format << "' is not one of Mono8, "
-              << "BayerRG8, BayerGR8, BayerGB8, BayerBG8\n";
-    return kExitBadInput;
+    return fail(kName, "--pixel-format: '" + args.pixel_format +
+                           "' is not one of Mono8, BayerRG8, BayerGR8, BayerGB8, BayerBG8");
   }
   const auto fsync = recording::parseFsyncPolicy(args.fsync);
-  if (!fsync) {
-    std::cerr << kName << "--fsync: '" << args.fsync << "' is not none, per_set or per_frame\n";
-    return kExitBadInput;
-  }
+  if (!fsync)
+    return fail(kName, "--fsync: '" + args.fsync + "' is not none, per_set or per_frame");
   options.writer.fsync = *fsync;
   std::vector<std::string> ids = args.cameras;
   if (ids.empty() && args.driver == "sim")
     ids = {"0", "1", "2", "3", "4", "5"};
-  if (ids.empty()) {
-    std::cerr << kName << "--camera: name the cameras of driver '" << args.driver << "'\n";
-    return kExitBadInput;
-  }
+  if (ids.empty())
+    return fail(kName, "--camera: name the cameras of driver '" + args.driver + "'");
   for (const std::string& id : ids) {
     drivers::CameraConfig camera;
     camera.id = id;
@@ -84,10 +79,8 @@ int runAcquire(const AcquireArgs& args) {
     camera.format = *format;
     for (const std::string& option : args.camera_options) {
       const auto equals = option.find('=');
-      if (equals == std::string::npos) {
-        std::cerr << kName << "--camera-option: '" << option << "' is not KEY=VALUE\n";
-        return kExitBadInput;
-      }
+      if (equals == std::string::npos)
+        return fail(kName, "--camera-option: '" + option + "' is not KEY=VALUE");
       camera.options[option.substr(0, equals)] = option.substr(equals + 1);
     }
     options.rig.cameras.push_back(camera);
@@ -103,14 +96,10 @@ int runAcquire(const AcquireArgs& args) {
 
   sim::addSimCamera(drivers::CameraRegistry::instance());  // drivers/ knows nothing of sim/
   auto acquisition = daemon::Acquisition::create(options, drivers::CameraRegistry::instance());
-  if (!acquisition) {
-    std::cerr << kName << acquisition.error().message << '\n';
-    return kExitBadInput;
-  }
-  if (auto started = (*acquisition)->start(); !started) {
-    std::cerr << kName << started.error().message << '\n';
-    return kExitRuntime;
-  }
+  if (!acquisition)
+    return fail(kName, acquisition.error().message);
+  if (auto started = (*acquisition)->start(); !started)
+    return fail(kName, started.error().message, kExitRuntime);
   const double cpu_before = cpuSeconds();
   const auto begin = std::chrono::steady_clock::now();
   const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -145,16 +134,15 @@ int runAcquire(const AcquireArgs& args) {
   summary["out"] = args.out;
   if (s.recording_stopped)
     summary["alarm"] = s.alarm;
-  std::cout << summary.dump() << '\n';
-  return s.recording_stopped ? kExitRuntime : kExitOk;
+  return printJsonLine(summary, s.recording_stopped ? kExitRuntime : kExitOk);
 }
 
 }  // namespace
 
 void registerAcquireCommand(CLI::App& app, int& exit_code) {
-  auto args = std::make_shared<AcquireArgs>();
-  CLI::App* cmd = app.add_subcommand(
-      "acquire", "Trigger N sets in software at a rate, record them, print a JSON summary");
+  const auto [cmd, args] = addSubcommand(
+      app, "acquire", "Trigger N sets in software at a rate, record them, print a JSON summary",
+      exit_code, runAcquire);
   cmd->add_option("--driver", args->driver, "camera driver")->capture_default_str();
   cmd->add_option("--camera", args->cameras,
                   "camera id, once per camera in rig order (sim: default 0-5)");
@@ -178,7 +166,6 @@ void registerAcquireCommand(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--camera-option", args->camera_options,
                   "KEY=VALUE for every camera (sim: drop_every, corrupt_every, delay_ms…)");
-  cmd->callback([args, &exit_code] { exit_code = runAcquire(*args); });
 }
 
 }  // namespace fieldrig::tools

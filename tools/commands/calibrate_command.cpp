@@ -11,7 +11,7 @@
 #include <optional>
 #include <sstream>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/stereo/calibrate.h"
 #include "fieldrig/stereo/calibration.h"
 
@@ -73,21 +73,16 @@ int runHeadPair(const CalibrateArgs& args, const stereo::BoardPairs& pairs,
     return kExitBadInput;
   }
   auto report = stereo::calibrateHeadToHead(*head_a, *head_b, pairs, board);
-  if (!report) {
-    std::cerr << who << report.error().message << '\n';
-    return kExitBadInput;
-  }
-  if (auto saved = stereo::saveHeadToHead(*report, args.out); !saved) {
-    std::cerr << who << saved.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!report)
+    return fail(who, report.error().message);
+  if (auto saved = stereo::saveHeadToHead(*report, args.out); !saved)
+    return fail(who, saved.error().message);
   Json out;
   out["out"] = args.out;
   out["rms"] = report->rms;
   out["pairs_used"] = report->views_used;
   out["b_to_a"] = matrixJson(report->b_to_a);
-  std::cout << out.dump() << '\n';
-  return kExitOk;
+  return printJsonLine(out);
 }
 
 int runHead(const CalibrateArgs& args, const stereo::BoardPairs& pairs,
@@ -96,15 +91,11 @@ int runHead(const CalibrateArgs& args, const stereo::BoardPairs& pairs,
   stereo::CalibrateOptions options;
   options.drop_factor = args.drop_factor;
   auto report = stereo::calibrateHead(pairs.pairs, board, pairs.image_size, options);
-  if (!report) {
-    std::cerr << who << report.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!report)
+    return fail(who, report.error().message);
   auto saved = stereo::saveStereoCalibration(report->calibration, args.out);
-  if (!saved) {
-    std::cerr << who << saved.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!saved)
+    return fail(who, saved.error().message);
   Json out;
   out["out"] = args.out;
   out["rms"] = report->rms;
@@ -125,8 +116,7 @@ int runHead(const CalibrateArgs& args, const stereo::BoardPairs& pairs,
     views.push_back(std::move(v));
   }
   out["views"] = std::move(views);
-  std::cout << out.dump() << '\n';
-  return kExitOk;
+  return printJsonLine(out);
 }
 
 int runCalibrate(const CalibrateArgs& args) {
@@ -136,10 +126,8 @@ int runCalibrate(const CalibrateArgs& args) {
     std::cerr << who << "--board '" << args.board << "' is not COLSxROWS (e.g. 9x6)\n";
     return kExitBadInput;
   }
-  if (!(args.square > 0)) {
-    std::cerr << who << "--square must be positive (metres)\n";
-    return kExitBadInput;
-  }
+  if (!(args.square > 0))
+    return fail(who, "--square must be positive (metres)");
   const stereo::BoardSpec board{*board_size, args.square};
   const std::vector<std::string> left = expandGlob(args.left);
   const std::vector<std::string> right = expandGlob(args.right);
@@ -153,10 +141,8 @@ int runCalibrate(const CalibrateArgs& args) {
     return kExitBadInput;
   }
   auto pairs = stereo::findBoardInImagePairs(left, right, board);
-  if (!pairs) {
-    std::cerr << who << pairs.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!pairs)
+    return fail(who, pairs.error().message);
   return args.head_pair ? runHeadPair(args, *pairs, board) : runHead(args, *pairs, board);
 }
 

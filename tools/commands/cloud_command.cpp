@@ -10,13 +10,12 @@
 #include <optional>
 #include <sstream>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/recording/session_reader.h"
-#include "fieldrig/stereo/preprocess.h"
 
 namespace fieldrig::tools {
 namespace {
@@ -41,70 +40,40 @@ std::vector<std::string> splitCommas(const std::string& text) {
 int runCloud(const CloudArgs& args) {
   const char* who = "fieldrig cloud: ";
   const auto start = std::chrono::steady_clock::now();
-  if (args.session.empty() == args.pairs.empty()) {
-    std::cerr << who << "give either a SESSION (with --set) or --pairs\n";
-    return kExitBadInput;
-  }
+  if (args.session.empty() == args.pairs.empty())
+    return fail(who, "give either a SESSION (with --set) or --pairs");
   std::optional<recording::SessionReader> reader;
   if (!args.session.empty()) {
-    if (args.set < 0) {
-      std::cerr << who << "--set is required with a SESSION\n";
-      return kExitBadInput;
-    }
+    if (args.set < 0)
+      return fail(who, "--set is required with a SESSION");
     auto opened = recording::SessionReader::open(args.session);
-    if (!opened) {
-      std::cerr << who << opened.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!opened)
+      return fail(who, opened.error().message);
     reader = std::move(*opened);
   }
   auto rig = daemon::loadRigFor(args.calib, reader ? &*reader : nullptr);
-  if (!rig) {
-    std::cerr << who << rig.error().message << '\n';
+  if (!rig)
+    return fail(who, rig.error().message);
+  const std::vector<std::string> files = splitCommas(args.pairs);
+  if (!reader && files.size() != 2 * rig->heads.size()) {
+    std::cerr << who << "--pairs names " << files.size() << " files; the rig in "
+              << (std::filesystem::path(args.calib) / "rig.yml").string() << " has "
+              << rig->heads.size() << " heads, so " << 2 * rig->heads.size()
+              << " are needed (L1,R1,L2,R2,…)\n";
     return kExitBadInput;
   }
   std::vector<std::string> problems;
-  std::vector<cloud::HeadFrames> frames;
-  if (reader) {
-    auto loaded = daemon::headFramesFromRecording(*reader, static_cast<std::uint64_t>(args.set),
-                                                  *rig, problems);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
-    frames = std::move(*loaded);
-  } else {
-    const std::vector<std::string> files = splitCommas(args.pairs);
-    if (files.size() != 2 * rig->heads.size()) {
-      std::cerr << who << "--pairs names " << files.size() << " files; the rig in "
-                << (std::filesystem::path(args.calib) / "rig.yml").string() << " has "
-                << rig->heads.size() << " heads, so " << 2 * rig->heads.size()
-                << " are needed (L1,R1,L2,R2,…)\n";
-      return kExitBadInput;
-    }
-    for (std::size_t i = 0; i < rig->heads.size(); ++i) {
-      cloud::HeadFrames head;
-      head.pixel_format = rig->pixel_format;
-      for (const auto& [file, image] :
-           {std::pair{&files[2 * i], &head.left}, std::pair{&files[2 * i + 1], &head.right}}) {
-        core::Result<cv::Mat> read = stereo::readFrameImage(*file);
-        if (!read) {
-          std::cerr << who << read.error().message << '\n';
-          return kExitBadInput;
-        }
-        *image = std::move(*read);
-      }
-      frames.push_back(std::move(head));
-    }
-  }
+  const auto frames = reader ? daemon::headFramesFromRecording(
+                                   *reader, static_cast<std::uint64_t>(args.set), *rig, problems)
+                             : daemon::headFramesFromImageFiles(files, *rig);
+  if (!frames)
+    return fail(who, frames.error().message);
   cloud::CloudOptions options;
   options.matcher.wls = args.wls;
   auto builder = cloud::CloudBuilder::create(*rig, options);
-  if (!builder) {
-    std::cerr << who << builder.error().message << '\n';
-    return kExitBadInput;
-  }
-  const cloud::FusionResult result = builder->build(frames);
+  if (!builder)
+    return fail(who, builder.error().message);
+  const cloud::FusionResult result = builder->build(*frames);
   Json heads = Json::array();
   for (const cloud::HeadStatus& head : result.heads) {
     Json h;
@@ -119,14 +88,10 @@ int runCloud(const CloudArgs& args) {
   }
   for (const std::string& problem : problems)
     std::cerr << who << problem << '\n';
-  if (result.cloud.empty()) {
-    std::cerr << who << "no head gave any point; nothing written\n";
-    return kExitBadInput;
-  }
-  if (auto written = cloud::writePly(result.cloud, args.out); !written) {
-    std::cerr << who << written.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (result.cloud.empty())
+    return fail(who, "no head gave any point; nothing written");
+  if (auto written = cloud::writePly(result.cloud, args.out); !written)
+    return fail(who, written.error().message);
   Json out;
   out["out"] = args.out;
   out["points"] = result.cloud.size();
@@ -134,16 +99,15 @@ int runCloud(const CloudArgs& args) {
   out["heads"] = std::move(heads);
   out["problems"] = problems;
   out["ms"] = core::millisecondsSince(start);
-  std::cout << out.dump() << '\n';
-  return kExitOk;
+  return printJsonLine(out);
 }
 
 }  // namespace
 
 void registerCloudCommand(CLI::App& app, int& exit_code) {
-  auto args = std::make_shared<CloudArgs>();
-  CLI::App* cmd = app.add_subcommand(
-      "cloud", "Fused three-head point cloud of one FrameSet in the plot frame (binary PLY)");
+  const auto [cmd, args] = addSubcommand(
+      app, "cloud", "Fused three-head point cloud of one FrameSet in the plot frame (binary PLY)",
+      exit_code, runCloud);
   cmd->add_option("session", args->session, "Recorded session folder");
   cmd->add_option("--set", args->set, "Set index in the session");
   cmd->add_option("--pairs", args->pairs, "L1,R1,L2,R2,L3,R3 image files, heads in rig order");
@@ -152,7 +116,6 @@ void registerCloudCommand(CLI::App& app, int& exit_code) {
                   "defaults to its calibration reference named calib_dir");
   cmd->add_flag("--wls", args->wls, "Apply the WLS disparity filter");
   cmd->add_option("--out", args->out, "Output .ply")->required();
-  cmd->callback([args, &exit_code] { exit_code = runCloud(*args); });
 }
 
 }  // namespace fieldrig::tools

@@ -7,7 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/stereo/calibration.h"
 #include "fieldrig/stereo/disparity_io.h"
 #include "fieldrig/stereo/pair_disparity.h"
@@ -40,25 +40,17 @@ int runDisparity(const DisparityArgs& args) {
               << " but the left image is " << left.cols << "x" << left.rows << '\n';
     return kExitBadInput;
   }
-  if (args.num_disparities <= 0 || args.num_disparities % 16 != 0) {
-    std::cerr << who << "--num-disparities must be a positive multiple of 16\n";
-    return kExitBadInput;
-  }
-  if (args.block_size < 1 || args.block_size % 2 == 0) {
-    std::cerr << who << "--block-size must be odd\n";
-    return kExitBadInput;
-  }
-  if (args.intrinsics.empty() != args.extrinsics.empty()) {
-    std::cerr << who << "--intrinsics and --extrinsics go together\n";
-    return kExitBadInput;
-  }
+  if (args.num_disparities <= 0 || args.num_disparities % 16 != 0)
+    return fail(who, "--num-disparities must be a positive multiple of 16");
+  if (args.block_size < 1 || args.block_size % 2 == 0)
+    return fail(who, "--block-size must be odd");
+  if (args.intrinsics.empty() != args.extrinsics.empty())
+    return fail(who, "--intrinsics and --extrinsics go together");
   std::optional<stereo::StereoCalibration> calibration;
   if (!args.intrinsics.empty()) {
     auto loaded = stereo::loadStereoCalibration(args.intrinsics, args.extrinsics);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!loaded)
+      return fail(who, loaded.error().message);
     calibration = std::move(*loaded);
     if (calibration->image_size.empty())  // OpenCV's own files do not carry it
       calibration->image_size = left.size();
@@ -76,32 +68,27 @@ int runDisparity(const DisparityArgs& args) {
   options.lr_check = args.lr_check;
   auto result =
       stereo::computePairDisparity(left, right, calibration ? &*calibration : nullptr, options);
-  if (!result) {
-    std::cerr << who << result.error().message << '\n';
-    return kExitBadInput;
-  }
-  if (auto written = stereo::writePfm(args.out, result->disparity); !written) {
-    std::cerr << who << written.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!result)
+    return fail(who, result.error().message);
+  if (auto written = stereo::writePfm(args.out, result->disparity); !written)
+    return fail(who, written.error().message);
   nlohmann::ordered_json out;
   out["out"] = args.out;
   out["width"] = result->disparity.cols;
   out["height"] = result->disparity.rows;
   out["valid_fraction"] = result->valid_fraction;
   out["match_ms"] = result->match_ms;
-  std::cout << out.dump() << '\n';
-  return kExitOk;
+  return printJsonLine(out);
 }
 
 }  // namespace
 
 void registerDisparityCommand(CLI::App& app, int& exit_code) {
-  auto args = std::make_shared<DisparityArgs>();
-  CLI::App* cmd =
-      app.add_subcommand("disparity",
-                         "Disparity of the left image (PFM, pixels; invalid = -1), rectified first "
-                         "when a calibration is given");
+  const auto [cmd, args] =
+      addSubcommand(app, "disparity",
+                    "Disparity of the left image (PFM, pixels; invalid = -1), rectified first "
+                    "when a calibration is given",
+                    exit_code, runDisparity);
   cmd->add_option("--left", args->left, "Left image")->required();
   cmd->add_option("--right", args->right, "Right image")->required();
   cmd->add_option("--intrinsics", args->intrinsics, "intrinsics.yml (M1 D1 M2 D2)");
@@ -113,7 +100,6 @@ void registerDisparityCommand(CLI::App& app, int& exit_code) {
   cmd->add_flag("--lr-check", args->lr_check,
                 "Match the right view too and drop inconsistent pixels");
   cmd->add_option("--out", args->out, "Output .pfm")->required();
-  cmd->callback([args, &exit_code] { exit_code = runDisparity(*args); });
 }
 
 }  // namespace fieldrig::tools

@@ -19,7 +19,7 @@
 #include <string_view>
 #include <utility>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "commands/field_plan_options.h"
 #include "fieldrig/core/durable_file.h"
 #include "fieldrig/core/time.h"
@@ -44,27 +44,20 @@ struct GenerateOptions {
 
 int runGenerate(const GenerateOptions& options) {
   const auto plan = resolveFieldPlan(options.field);
-  if (!plan) {
-    std::cerr << "fieldrig map generate: " << plan.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!plan)
+    return fail("fieldrig map generate: ", plan.error().message);
   auto map = gps::generateLocations(*plan);
-  if (!map) {
-    std::cerr << "fieldrig map generate: " << map.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!map)
+    return fail("fieldrig map generate: ", map.error().message);
   auto saved = map->save(options.out);
-  if (!saved) {
-    std::cerr << "fieldrig map generate: " << saved.error().message << '\n';
-    return kExitRuntime;
-  }
+  if (!saved)
+    return fail("fieldrig map generate: ", saved.error().message, kExitRuntime);
   Json summary;
   summary["out"] = options.out;
   summary["locations"] = map->size();
   summary["rows"] = plan->rows;
   summary["plots_per_row"] = map->size() / static_cast<std::size_t>(plan->rows);
-  std::cout << summary.dump() << '\n';
-  return kExitOk;
+  return printJsonLine(summary);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -161,10 +154,8 @@ int runRecord(const RecordOptions& options) {
   }
   const bool live = type != std::filesystem::file_type::regular;
   auto existing = gps::openRecordingMap(options.out);
-  if (!existing) {
-    std::cerr << kName << existing.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!existing)
+    return fail(kName, existing.error().message);
   const std::size_t already_there = existing->size();
   gps::MapRecorderOptions recorder_options;
   recorder_options.id_prefix = options.id_prefix;
@@ -235,10 +226,8 @@ int runRecord(const RecordOptions& options) {
                       << s.retry_in.count() << " ms\n";
           }
         });
-    if (!created) {
-      std::cerr << kName << created.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!created)
+      return fail(kName, created.error().message);
     serial = std::move(*created);
   } else {
     sim::NmeaPacing pacing;
@@ -254,10 +243,8 @@ int runRecord(const RecordOptions& options) {
           recorder.flush();
           io.stop();
         });
-    if (!opened) {
-      std::cerr << kName << opened.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!opened)
+      return fail(kName, opened.error().message);
     player = std::move(*opened);
   }
 
@@ -288,15 +275,12 @@ int runRecord(const RecordOptions& options) {
 }  // namespace
 
 void registerMapCommand(CLI::App& app, int& exit_code) {
-  CLI::App* map = app.add_subcommand("map", "Imaging-location maps");
-  map->require_subcommand(1);
+  CLI::App* map = addCommandGroup(app, "map", "Imaging-location maps");
 
-  CLI::App* generate =
-      map->add_subcommand("generate", "Write a map of plot centres from a field plan");
-  auto g = std::make_shared<GenerateOptions>();
+  const auto [generate, g] = addSubcommand(
+      *map, "generate", "Write a map of plot centres from a field plan", exit_code, runGenerate);
   addFieldPlanOptions(*generate, g->field);
   generate->add_option("--out", g->out, "Map file to write")->required();
-  generate->callback([g, &exit_code] { exit_code = runGenerate(*g); });
 
   CLI::App* record = map->add_subcommand(
       "record", "Drive the field and mark imaging locations with Enter or SIGUSR1");

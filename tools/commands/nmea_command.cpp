@@ -5,7 +5,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/gps/nmea_parser.h"
 
 namespace fieldrig::tools {
@@ -27,11 +27,17 @@ int fractionDigits(core::Nanoseconds time_of_day) {
   return digits;
 }
 
+// The fields every sentence's object starts with.
+Json sentenceJson(const gps::Sentence& s, const char* kind) {
+  Json out;
+  out["sentence"] = kind;
+  out["talker"] = s.talker;
+  return out;
+}
+
 Json rmcJson(const gps::Sentence& s) {
   const gps::RmcData& rmc = s.rmc;
-  Json out;
-  out["sentence"] = "RMC";
-  out["talker"] = s.talker;
+  Json out = sentenceJson(s, "RMC");
   out["time"] = rmc.time ? Json(core::formatIso8601(*rmc.time, fractionDigits(*rmc.time_of_day)))
                          : Json(nullptr);
   out["valid"] = rmc.status_active;  // the contract: status A (mode N is in "mode")
@@ -46,9 +52,7 @@ Json rmcJson(const gps::Sentence& s) {
 
 Json ggaJson(const gps::Sentence& s) {
   const gps::GgaData& gga = s.gga;
-  Json out;
-  out["sentence"] = "GGA";
-  out["talker"] = s.talker;
+  Json out = sentenceJson(s, "GGA");
   out["time_of_day"] =
       gga.time_of_day
           ? Json(core::formatTimeOfDay(*gga.time_of_day, fractionDigits(*gga.time_of_day)))
@@ -109,8 +113,7 @@ int runDecode(const std::string& path) {
 }  // namespace
 
 void registerNmeaCommand(CLI::App& app, int& exit_code) {
-  CLI::App* nmea = app.add_subcommand("nmea", "NMEA 0183 tools");
-  nmea->require_subcommand(1);
+  CLI::App* nmea = addCommandGroup(app, "nmea", "NMEA 0183 tools");
   CLI::App* decode =
       nmea->add_subcommand("decode", "Print every intact RMC/GGA sentence of FILE as JSON lines");
   auto path = std::make_shared<std::string>();

@@ -1,17 +1,16 @@
 // `fieldrig process SESSION [--calib DIR] [--map MAP.csv] [--config FILE] [--traits-config FILE]
 //  [--out DIR] [--shard K/N] [--force] [--clouds]`: every FrameSet of a recorded session through
-//  the plot
-// processor, the daemon's own (daemon/session_processing.h), into the results folder (plots.jsonl,
-// plots.csv, plots.geojson; daemon/results_writer.h), one JSON line per set on stdout and a summary
-// line last. It resumes: sets already in the folder's plots.jsonl (by trigger id) are skipped
-// unless --force.
+// the plot processor, the daemon's own (daemon/session_processing.h), into the results folder
+// (plots.jsonl, plots.csv, plots.geojson; daemon/results_writer.h), one JSON line per set on stdout
+// and a summary line last. It resumes: sets already in the folder's plots.jsonl (by trigger id) are
+// skipped unless --force.
 #include <charconv>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/config/config.h"
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/daemon/results_writer.h"
@@ -53,74 +52,52 @@ int runProcess(const ProcessArgs& args) {
     return kExitBadInput;
   }
   auto opened = recording::SessionReader::open(args.session);
-  if (!opened) {
-    std::cerr << who << opened.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!opened)
+    return fail(who, opened.error().message);
   const recording::SessionReader& reader = *opened;
   auto rig = daemon::loadRigFor(args.calib, &reader);
-  if (!rig) {
-    std::cerr << who << rig.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!rig)
+    return fail(who, rig.error().message);
   pipeline::ProcessorOptions options;
   options.keep_cloud = args.clouds;
   if (!args.config.empty()) {  // the daemon's file: its processing options, nothing else
     auto loaded = config::loadConfig(args.config);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!loaded)
+      return fail(who, loaded.error().message);
     options.cloud = loaded->pipeline.cloud;
     options.traits = loaded->pipeline.traits;
   }
   if (!args.traits_config.empty()) {  // overrides the configuration's traits
     auto loaded = config::loadTraitsOptions(args.traits_config);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!loaded)
+      return fail(who, loaded.error().message);
     options.traits = *loaded;
   }
   std::optional<gps::LocationMap> map;
   if (!args.map.empty()) {
     auto loaded = gps::LocationMap::load(args.map);
-    if (!loaded) {
-      std::cerr << who << loaded.error().message << '\n';
-      return kExitBadInput;
-    }
+    if (!loaded)
+      return fail(who, loaded.error().message);
     map = std::move(*loaded);
   }
   auto processor = pipeline::PlotProcessor::create(*rig, options);
-  if (!processor) {
-    std::cerr << who << processor.error().message << '\n';
-    return kExitBadInput;
-  }
-  fs::path out_dir = args.out.empty() ? reader.dir() / "results" : fs::path(args.out);
-  if (args.out.empty() && run.shard_count > 1) {  // shards never write the same file
-    out_dir /=
-        "shard-" + std::to_string(run.shard_index) + "-of-" + std::to_string(run.shard_count);
-  }
-  if (args.force) {
-    std::error_code ec;
-    for (const char* name : {"plots.jsonl", "plots.csv", "plots.geojson"})
-      fs::remove(out_dir / name, ec);
-  }
+  if (!processor)
+    return fail(who, processor.error().message);
+  const fs::path out_dir =
+      args.out.empty() ? daemon::defaultResultsDir(reader.dir(), run) : fs::path(args.out);
+  if (args.force)
+    daemon::removeResults(out_dir);
   auto results = daemon::ResultsWriter::open(out_dir);
-  if (!results) {
-    std::cerr << who << results.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!results)
+    return fail(who, results.error().message);
   if (args.clouds)
     run.clouds_dir = out_dir;
   auto done = daemon::processSession(
       reader, *processor, map ? &*map : nullptr, **results, run,
       [](const Json& line) { std::cout << line.dump() << std::endl; },
       [who](const std::string& problem) { std::cerr << who << problem << '\n'; });
-  if (!done) {
-    std::cerr << who << done.error().message << '\n';
-    return kExitRuntime;
-  }
+  if (!done)
+    return fail(who, done.error().message, kExitRuntime);
   Json summary;
   summary["sets"] = done->sets;
   summary["ok"] = done->ok;
@@ -128,9 +105,10 @@ int runProcess(const ProcessArgs& args) {
   summary["unplaced"] = done->unplaced;
   summary["already_done"] = done->already_done;
   summary["plots_in_results"] = (*results)->plots();
-  summary["csv"] = (out_dir / "plots.csv").string();
-  summary["geojson"] = (out_dir / "plots.geojson").string();
-  summary["jsonl"] = (out_dir / "plots.jsonl").string();
+  const daemon::ResultsFiles files = daemon::resultsFiles(out_dir);
+  summary["csv"] = files.csv.string();
+  summary["geojson"] = files.geojson.string();
+  summary["jsonl"] = files.jsonl.string();
   std::cout << Json{{"summary", summary}}.dump() << std::endl;
   return kExitOk;
 }
@@ -138,9 +116,9 @@ int runProcess(const ProcessArgs& args) {
 }  // namespace
 
 void registerProcessCommand(CLI::App& app, int& exit_code) {
-  auto args = std::make_shared<ProcessArgs>();
-  CLI::App* process = app.add_subcommand(
-      "process", "Every FrameSet of a session → fused cloud → plot traits (CSV and GeoJSON)");
+  const auto [process, args] = addSubcommand(
+      app, "process", "Every FrameSet of a session → fused cloud → plot traits (CSV and GeoJSON)",
+      exit_code, runProcess);
   process->add_option("session", args->session, "Session folder")->required();
   process->add_option("--calib", args->calib,
                       "Calibration folder (rig.yml + one folder per head); default: the "
@@ -162,7 +140,6 @@ void registerProcessCommand(CLI::App& app, int& exit_code) {
                     "Process every set again (default: resume, skipping the sets already in the "
                     "results)");
   process->add_flag("--clouds", args->clouds, "Also write each set's fused cloud as PLY");
-  process->callback([args, &exit_code] { exit_code = runProcess(*args); });
 }
 
 }  // namespace fieldrig::tools

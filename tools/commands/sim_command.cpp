@@ -6,7 +6,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "commands/field_plan_options.h"
 #include "fieldrig/sim/drive_simulator.h"
 
@@ -26,10 +26,8 @@ struct DriveArgs {
 int runDrive(const DriveArgs& args) {
   constexpr std::string_view kName = "fieldrig sim drive: ";
   const auto plan = resolveFieldPlan(args.field);
-  if (!plan) {
-    std::cerr << kName << plan.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!plan)
+    return fail(kName, plan.error().message);
   sim::DriveOptions options = args.drive;
   if (!args.start.empty()) {
     const auto start = core::parseIso8601(args.start);
@@ -40,10 +38,8 @@ int runDrive(const DriveArgs& args) {
     options.start = *start;
   }
   const auto map = gps::generateLocations(*plan);
-  if (!map) {
-    std::cerr << kName << map.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!map)
+    return fail(kName, map.error().message);
   const sim::DriveSimulator drive(*plan, options);
   std::ofstream nmea(args.out_nmea, std::ios::binary);
   nmea << drive.nmea();
@@ -52,10 +48,8 @@ int runDrive(const DriveArgs& args) {
     std::cerr << kName << "cannot write '" << args.out_nmea << "'\n";
     return kExitRuntime;
   }
-  if (const auto saved = map->save(args.out_map); !saved) {
-    std::cerr << kName << saved.error().message << '\n';
-    return kExitRuntime;
-  }
+  if (const auto saved = map->save(args.out_map); !saved)
+    return fail(kName, saved.error().message, kExitRuntime);
   Json summary;
   summary["nmea"] = args.out_nmea;
   summary["map"] = args.out_map;
@@ -63,18 +57,16 @@ int runDrive(const DriveArgs& args) {
   summary["length_m"] = drive.lengthM();
   summary["start"] = core::formatIso8601(drive.start(), 2);
   summary["end"] = core::formatIso8601(drive.end(), 2);
-  std::cout << summary.dump() << '\n';
-  return kExitOk;
+  return printJsonLine(summary);
 }
 
 }  // namespace
 
 void registerSimCommand(CLI::App& app, int& exit_code) {
-  CLI::App* sim = app.add_subcommand("sim", "Simulated data for hardware-free runs");
-  sim->require_subcommand(1);
-  CLI::App* drive = sim->add_subcommand(
-      "drive", "Write the NMEA of a simulated serpentine drive and the plan's location map");
-  auto args = std::make_shared<DriveArgs>();
+  CLI::App* sim = addCommandGroup(app, "sim", "Simulated data for hardware-free runs");
+  const auto [drive, args] = addSubcommand(
+      *sim, "drive", "Write the NMEA of a simulated serpentine drive and the plan's location map",
+      exit_code, runDrive);
   addFieldPlanOptions(*drive, args->field);
   sim::DriveOptions& d = args->drive;
   drive->add_option("--speed", d.speed_mps, "Ground speed, m/s")
@@ -94,7 +86,6 @@ void registerSimCommand(CLI::App& app, int& exit_code) {
   drive->add_option("--start", args->start, "GPS time of the first fix (ISO-8601 UTC)");
   drive->add_option("--out-nmea", args->out_nmea, "NMEA file to write")->required();
   drive->add_option("--out-map", args->out_map, "Location map to write")->required();
-  drive->callback([args, &exit_code] { exit_code = runDrive(*args); });
   registerSimPlotsSubcommand(*sim, exit_code);
 }
 

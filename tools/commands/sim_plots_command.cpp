@@ -8,8 +8,9 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/sim/synthetic_field.h"
 
 namespace fieldrig::tools {
@@ -17,6 +18,17 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
+
+// --height-min and --height-max: the plants' height in the first plot and in the last.
+void addHeightRangeOptions(CLI::App& command, double& min_m, double& max_m) {
+  for (auto [name, value, description] :
+       {std::tuple{"--height-min", &min_m, "Plant height of the first plot, m"},
+        std::tuple{"--height-max", &max_m, "Plant height of the last plot, m"}}) {
+    command.add_option(name, *value, description)
+        ->capture_default_str()
+        ->check(CLI::Range(0.3, 2.8));
+  }
+}
 
 struct PlotsArgs {
   std::string out, calib_out;
@@ -31,17 +43,14 @@ int runPlots(const PlotsArgs& args) {
   for (int index = 0; index < args.series.count; ++index)
     locations.push_back("plot-" + std::to_string(index + 1));
   auto recorded = sim::recordSyntheticPlots(session_dir, calib_dir, args.series, locations);
-  if (!recorded) {
-    std::cerr << "fieldrig sim plots: " << recorded.error().message << '\n';
-    return kExitRuntime;
-  }
+  if (!recorded)
+    return fail("fieldrig sim plots: ", recorded.error().message, kExitRuntime);
   Json summary;
   summary["session"] = session_dir.string();
   summary["calib"] = calib_dir.string();
   summary["plots"] = recorded->size();
   summary["truth"] = (session_dir / "truth.jsonl").string();
-  std::cout << summary.dump() << '\n';
-  return kExitOk;
+  return printJsonLine(summary);
 }
 
 struct FieldArgs {
@@ -54,10 +63,8 @@ int runSimulate(const FieldArgs& args) {
     std::cerr << "fieldrig simulate: rendered " << plot.location_id << " (set " << plot.set_index
               << ")\n";
   });
-  if (!files) {
-    std::cerr << "fieldrig simulate: " << files.error().message << '\n';
-    return kExitRuntime;
-  }
+  if (!files)
+    return fail("fieldrig simulate: ", files.error().message, kExitRuntime);
   Json summary;
   summary["nmea"] = files->nmea.string();
   summary["map"] = files->map.string();
@@ -66,16 +73,15 @@ int runSimulate(const FieldArgs& args) {
   summary["truth"] = files->truth.string();
   summary["locations"] = files->locations;
   summary["plots"] = files->plots;
-  std::cout << summary.dump() << '\n';
-  return kExitOk;
+  return printJsonLine(summary);
 }
 
 }  // namespace
 
 void registerSimPlotsSubcommand(CLI::App& sim, int& exit_code) {
-  auto args = std::make_shared<PlotsArgs>();
-  CLI::App* plots = sim.add_subcommand(
-      "plots", "Record a session of synthetic row plots (six raw frames each) with its truth");
+  const auto [plots, args] = addSubcommand(
+      sim, "plots", "Record a session of synthetic row plots (six raw frames each) with its truth",
+      exit_code, runPlots);
   plots->add_option("--out", args->out, "Session folder to write")->required();
   plots->add_option("--calib-out", args->calib_out,
                     "Calibration folder to write (default SESSION/calib)");
@@ -83,20 +89,14 @@ void registerSimPlotsSubcommand(CLI::App& sim, int& exit_code) {
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   plots->add_option("--seed", args->series.seed, "Scene seed")->capture_default_str();
-  plots->add_option("--height-min", args->series.height_min_m, "Plant height of the first plot, m")
-      ->capture_default_str()
-      ->check(CLI::Range(0.3, 2.8));
-  plots->add_option("--height-max", args->series.height_max_m, "Plant height of the last plot, m")
-      ->capture_default_str()
-      ->check(CLI::Range(0.3, 2.8));
-  plots->callback([args, &exit_code] { exit_code = runPlots(*args); });
+  addHeightRangeOptions(*plots, args->series.height_min_m, args->series.height_max_m);
 }
 
 void registerSimulateCommand(CLI::App& app, int& exit_code) {
-  auto args = std::make_shared<FieldArgs>();
-  CLI::App* simulate = app.add_subcommand(
-      "simulate",
-      "Write a synthetic field to replay through fieldrigd: drive NMEA, map, session, truth");
+  const auto [simulate, args] = addSubcommand(
+      app, "simulate",
+      "Write a synthetic field to replay through fieldrigd: drive NMEA, map, session, truth",
+      exit_code, runSimulate);
   simulate->add_option("--out", args->out, "Folder to write")->required();
   simulate->add_option("--plots", args->spec.plots, "Number of plots")
       ->capture_default_str()
@@ -106,16 +106,10 @@ void registerSimulateCommand(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(1, 200));
   simulate->add_option("--seed", args->spec.seed, "Seed of the drive noise and the scenes")
       ->capture_default_str();
-  simulate->add_option("--height-min", args->spec.height_min_m, "Plant height of the first plot, m")
-      ->capture_default_str()
-      ->check(CLI::Range(0.3, 2.8));
-  simulate->add_option("--height-max", args->spec.height_max_m, "Plant height of the last plot, m")
-      ->capture_default_str()
-      ->check(CLI::Range(0.3, 2.8));
+  addHeightRangeOptions(*simulate, args->spec.height_min_m, args->spec.height_max_m);
   simulate->add_option("--speed", args->spec.speed_mps, "Ground speed, m/s")
       ->capture_default_str()
       ->check(CLI::Range(0.5, 5.0));
-  simulate->callback([args, &exit_code] { exit_code = runSimulate(*args); });
 }
 
 }  // namespace fieldrig::tools

@@ -15,7 +15,7 @@
 #include <sstream>
 #include <vector>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/core/pixel_format.h"
 #include "fieldrig/stem/measurement_json.h"
 #include "fieldrig/stem/stem_measurer.h"
@@ -73,27 +73,24 @@ core::Result<cv::Mat> loadGreyImage(const std::filesystem::path& file, const std
 }
 
 int runStem(const StemArgs& args) {
-  const auto fail = [](const std::string& message) {
-    std::cerr << "fieldrig stem: " << message << '\n';
-    return kExitBadInput;
-  };
+  constexpr std::string_view kName = "fieldrig stem: ";
   core::Result<stem::Points4> points = parseStemPoints(args.points);
   if (!points)
-    return fail("--points: " + points.error().message);
+    return fail(kName, "--points: " + points.error().message);
   core::Result<stereo::StereoCalibration> calibration =
       stereo::loadStereoCalibration(args.intrinsics, args.extrinsics);
   if (!calibration)
-    return fail(calibration.error().message);
+    return fail(kName, calibration.error().message);
   core::Result<cv::Mat> left = loadGreyImage(args.left, args.bayer);
   if (!left)
-    return fail(left.error().message);
+    return fail(kName, left.error().message);
   core::Result<cv::Mat> right = loadGreyImage(args.right, args.bayer);
   if (!right)
-    return fail(right.error().message);
+    return fail(kName, right.error().message);
   core::Result<stem::StemMeasurer> measurer =
       stem::StemMeasurer::create(*calibration, *left, *right);
   if (!measurer)
-    return fail(measurer.error().message);
+    return fail(kName, measurer.error().message);
   stem::MeasureOptions options;
   options.refine_edges = !args.face_value;
   options.cylinder_model = !args.plane;
@@ -106,16 +103,17 @@ int runStem(const StemArgs& args) {
   }
   if (m.ok())
     return kExitOk;
-  std::cerr << "fieldrig stem: " << m.message << '\n';
-  return m.status == stem::MeasureStatus::kBadPoints ? kExitBadInput : kExitRuntime;
+  return fail(kName, m.message,
+              m.status == stem::MeasureStatus::kBadPoints ? kExitBadInput : kExitRuntime);
 }
 
 }  // namespace
 
 void registerStemCommand(CLI::App& app, int& exit_code) {
-  CLI::App* command = app.add_subcommand(
-      "stem", "Stem diameter from four clicks on its edges in the raw left image of a stereo pair");
-  auto args = std::make_shared<StemArgs>();
+  const auto [command, args] = addSubcommand(
+      app, "stem",
+      "Stem diameter from four clicks on its edges in the raw left image of a stereo pair",
+      exit_code, runStem);
   command->add_option("--left", args->left, "Left image (raw, as recorded)")->required();
   command->add_option("--right", args->right, "Right image (raw, as recorded)")->required();
   command->add_option("--intrinsics", args->intrinsics, "intrinsics.yml (M1 D1 M2 D2)")->required();
@@ -132,7 +130,6 @@ void registerStemCommand(CLI::App& app, int& exit_code) {
                     "Take the clicks as the edges (no sub-pixel edge search), as the paper did");
   command->add_flag("--plane", args->plane,
                     "Diameter by eq. 13 (fronto-parallel patch) instead of the cylinder model");
-  command->callback([args, &exit_code] { exit_code = runStem(*args); });
 }
 
 }  // namespace fieldrig::tools

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "stem_page/http_server.h"
 #include "stem_page/stem_page.h"
 
@@ -21,13 +21,11 @@ struct StemUiArgs {
   std::string bind = "127.0.0.1";
 };
 
-int runStemUi(StemUiArgs args) {
+int runStemUi(const StemUiArgs& args) {
   const char* who = "fieldrig stem-ui: ";
-  auto page = stem_page::StemPage::open(std::move(args.page));
-  if (!page) {
-    std::cerr << who << page.error().message << '\n';
-    return kExitBadInput;
-  }
+  auto page = stem_page::StemPage::open(args.page);
+  if (!page)
+    return fail(who, page.error().message);
   boost::system::error_code ec;
   const boost::asio::ip::address address = boost::asio::ip::make_address(args.bind, ec);
   if (ec) {
@@ -39,10 +37,8 @@ int runStemUi(StemUiArgs args) {
     return kExitBadInput;
   }
   auto server = stem_page::HttpServer::listen(address, static_cast<std::uint16_t>(args.port));
-  if (!server) {
-    std::cerr << who << server.error().message << '\n';
-    return kExitRuntime;
-  }
+  if (!server)
+    return fail(who, server.error().message, kExitRuntime);
   std::cout << who << "serving http://" << args.bind << ":" << (*server)->port() << "/"
             << std::endl;
   (*server)->run(
@@ -52,9 +48,10 @@ int runStemUi(StemUiArgs args) {
 }  // namespace
 
 void registerStemUiCommand(CLI::App& app, int& exit_code) {
-  CLI::App* command = app.add_subcommand(
-      "stem-ui", "Serve the stem measurement page for recorded sessions (http://127.0.0.1:PORT/)");
-  auto args = std::make_shared<StemUiArgs>();
+  const auto [command, args] = addSubcommand(
+      app, "stem-ui",
+      "Serve the stem measurement page for recorded sessions (http://127.0.0.1:PORT/)", exit_code,
+      runStemUi);
   command->add_option("sessions", args->page.sessions, "Session folders")->required();
   command->add_option("--port", args->port, "TCP port (0: any free port)")->capture_default_str();
   command->add_option("--bind", args->bind, "Address to listen on")->capture_default_str();
@@ -62,7 +59,6 @@ void registerStemUiCommand(CLI::App& app, int& exit_code) {
                       "Calibration folder: DIR/{bottom,middle,top}/{intrinsics,extrinsics}.yml");
   command->add_option("--out", args->page.out,
                       "CSV of the measurements (default: SESSION_DIR/stem_measurements.csv)");
-  command->callback([args, &exit_code] { exit_code = runStemUi(*args); });
 }
 
 }  // namespace fieldrig::tools

@@ -1,7 +1,7 @@
 // `fieldrig traits --cloud FILE [--frame plot|camera] [--config FILE] [--area depth_map|paper]
 // --json`: the traits of one plot cloud as one JSON object.
 // `fieldrig traits synth --out plot.ply [--truth truth.json] ...`: a synthetic row plot with its
-// truth (the trait definitions on the noise-free visible geometry, the visible surface area).
+// truth (sim/plots: the generator, and the trait definitions on its noise-free visible geometry).
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -36,12 +36,7 @@ struct SynthArgs {
   std::string out;
   std::string truth;
   std::string frame = "plot";
-  double height = 2.0;
-  double noise = 0.003;
-  double row_length = 1.5;
-  int tall_plant = -1;
-  std::vector<int> missing;
-  std::uint32_t seed = 1;
+  sim::PlotSpec spec;  // the options below are bound to its fields, defaults included
   std::size_t points = 0;
   bool no_plants = false;
 };
@@ -85,49 +80,21 @@ int runTraits(const TraitsArgs& args) {
   return kExitOk;
 }
 
-// The trait definitions on the generator's noise-free visible plant geometry (sim::plotTruth).
-Json truthJson(const sim::PlotCloud& plot, const traits::TraitsOptions& options) {
-  const sim::PlotTruthTraits truth_traits = sim::plotTruth(plot, options);
-  const traits::TraitsResult& d = truth_traits.definitions;
-  const double area = truth_traits.visible_area_m2;
-  Json truth;
-  truth["status"] = traits::statusName(d.status);
-  truth["height_m"] = d.height_m;
-  truth["width_m"] = d.width_m;
-  truth["vvi"] = d.vvi;
-  truth["ega_m2"] = d.ega_m2;
-  truth["total_volume_m3"] = d.total_volume_m3;
-  truth["visible_area_in_box_m2"] = area;
-  truth["vai"] = truth_traits.vai;
-  truth["ground_x_m"] = plot.truth.ground_x_m;
-  truth["base_depth_m"] = plot.truth.base_depth_m;
-  truth["visible_plant_area_m2"] = plot.truth.visible_plant_area_m2;
-  truth["total_plant_area_m2"] = plot.truth.total_plant_area_m2;
-  truth["plant_y_m"] = plot.truth.plant_y_m;
-  truth["plant_height_m"] = plot.truth.plant_height_m;
-  return truth;
-}
-
 int runSynth(const SynthArgs& args) {
-  sim::PlotSpec spec;
-  spec.plant_height_m = args.height;
-  spec.depth_noise_m = args.noise;
-  spec.row_length_m = args.row_length;
-  spec.tall_plant = args.tall_plant;
-  spec.missing_plants = args.missing;
-  spec.seed = args.seed;
+  sim::PlotSpec spec = args.spec;
   spec.plants = !args.no_plants;
   sim::PlotCloud plot = sim::generatePlot(spec);
   if (args.points > 0)
-    sim::subsamplePlot(plot, args.points, args.seed);
-  Eigen::Matrix3f to_output = Eigen::Matrix3f::Identity();
-  if (args.frame == "camera")
-    to_output = traits::TraitsOptions{}.camera_to_plot.transpose().cast<float>();
+    sim::subsamplePlot(plot, args.points, spec.seed);
+  const traits::TraitsOptions options;
+  const traits::InputFrame frame =
+      args.frame == "camera" ? traits::InputFrame::kCamera : traits::InputFrame::kPlot;
+  const std::vector<Eigen::Vector3f> points = sim::observedPoints(plot, frame, options);
   cloud::Cloud out;
-  out.reserve(plot.points.size());
-  for (std::size_t i = 0; i < plot.points.size(); ++i) {
+  out.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
     pcl::PointXYZRGB p;
-    p.getVector3fMap() = to_output * plot.points[i];
+    p.getVector3fMap() = points[i];
     p.r = plot.colors[i][0];
     p.g = plot.colors[i][1];
     p.b = plot.colors[i][2];
@@ -138,7 +105,7 @@ int runSynth(const SynthArgs& args) {
     return kExitBadInput;
   }
   if (!args.truth.empty()) {
-    Json truth = truthJson(plot, traits::TraitsOptions{});
+    Json truth = sim::plotTruthJson(plot, options);
     truth["points"] = out.size();
     truth["frame"] = args.frame;
     core::Result<bool> written = traits::writeText(args.truth, truth.dump(1) + "\n");
@@ -178,18 +145,19 @@ void registerTraitsCommand(CLI::App& app, int& exit_code) {
   synth->add_option("--frame", synth_args->frame, "plot or camera")
       ->check(CLI::IsMember({"plot", "camera"}))
       ->capture_default_str();
-  synth->add_option("--height", synth_args->height, "Plant height, m")
+  synth->add_option("--height", synth_args->spec.plant_height_m, "Plant height, m")
       ->check(CLI::Range(0.2, 5.0))
       ->capture_default_str();
-  synth->add_option("--noise", synth_args->noise, "Depth noise sigma, m")
+  synth->add_option("--noise", synth_args->spec.depth_noise_m, "Depth noise sigma, m")
       ->check(CLI::Range(0.0, 0.05))
       ->capture_default_str();
-  synth->add_option("--row-length", synth_args->row_length, "Imaged row length, m")
+  synth->add_option("--row-length", synth_args->spec.row_length_m, "Imaged row length, m")
       ->check(CLI::Range(0.1, 10.0))
       ->capture_default_str();
-  synth->add_option("--tall-plant", synth_args->tall_plant, "Index of one abnormal tall plant");
-  synth->add_option("--missing", synth_args->missing, "Indices of missing plants");
-  synth->add_option("--seed", synth_args->seed, "Random seed")->capture_default_str();
+  synth->add_option("--tall-plant", synth_args->spec.tall_plant,
+                    "Index of one abnormal tall plant");
+  synth->add_option("--missing", synth_args->spec.missing_plants, "Indices of missing plants");
+  synth->add_option("--seed", synth_args->spec.seed, "Random seed")->capture_default_str();
   synth->add_option("--points", synth_args->points, "Keep this many points (random)");
   synth->add_flag("--no-plants", synth_args->no_plants, "Soil only");
   synth->callback([synth_args, &exit_code] { exit_code = runSynth(*synth_args); });

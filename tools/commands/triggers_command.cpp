@@ -8,7 +8,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/gps/location_map.h"
 #include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/gps/trigger_replay.h"
@@ -92,10 +92,8 @@ int runLive(const TriggersArgs& args, const gps::LocationMap& map) {
       io, map, serial, args.replay, handlers, [](const gps::SerialStatus& status) {
         std::cerr << serialStatusJson(status).dump() << std::endl;
       });
-  if (!chain) {
-    std::cerr << "fieldrig triggers: " << chain.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!chain)
+    return fail("fieldrig triggers: ", chain.error().message);
   boost::asio::signal_set signals(io, SIGINT, SIGTERM);
   signals.async_wait([&](const boost::system::error_code&, int) { chain->stop(); });
   chain->start();
@@ -106,10 +104,8 @@ int runLive(const TriggersArgs& args, const gps::LocationMap& map) {
 
 int runTriggers(const TriggersArgs& args) {
   const auto map = gps::LocationMap::load(args.map_path);
-  if (!map) {
-    std::cerr << "fieldrig triggers: " << map.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!map)
+    return fail("fieldrig triggers: ", map.error().message);
   if (map->empty()) {
     std::cerr << "fieldrig triggers: " << args.map_path << ": the map has no locations\n";
     return kExitBadInput;
@@ -130,10 +126,8 @@ int runTriggers(const TriggersArgs& args) {
   handlers.on_alarm = printAlarm;
   const auto summary = gps::replayTriggers(nmea, *map, args.replay, handlers);
   std::cout.flush();
-  if (!summary) {
-    std::cerr << "fieldrig triggers: " << summary.error().message << '\n';
-    return kExitBadInput;
-  }
+  if (!summary)
+    return fail("fieldrig triggers: ", summary.error().message);
   std::cerr << summaryJson(*map, summary->nmea, summary->planner).dump() << '\n';
   return kExitOk;
 }
@@ -141,10 +135,11 @@ int runTriggers(const TriggersArgs& args) {
 }  // namespace
 
 void registerTriggersCommand(CLI::App& app, int& exit_code) {
-  auto args = std::make_shared<TriggersArgs>();
+  const auto [cmd, args] =
+      addSubcommand(app, "triggers",
+                    "Replay an NMEA capture against an imaging-location map and print the triggers",
+                    exit_code, runTriggers);
   gps::TriggerOptions& p = args->replay.planner;
-  CLI::App* cmd = app.add_subcommand(
-      "triggers", "Replay an NMEA capture against an imaging-location map and print the triggers");
   cmd->add_option("--map", args->map_path, "imaging-location map (CSV)")->required();
   cmd->add_option("--nmea", args->nmea_path,
                   "NMEA capture to replay in GPS time, or a serial device to run live")
@@ -168,7 +163,6 @@ void registerTriggersCommand(CLI::App& app, int& exit_code) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--lead", p.trigger_lead_s, "fire this many seconds before the crossing")
       ->capture_default_str();
-  cmd->callback([args, &exit_code] { exit_code = runTriggers(*args); });
 }
 
 }  // namespace fieldrig::tools

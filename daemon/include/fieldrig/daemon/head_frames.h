@@ -1,5 +1,5 @@
-// The two adapters in front of the plot processor: a recorded set, or a live FrameSet, as the
-// per-head images it takes (in the order of the calibration's heads), and where a session's
+// The adapters in front of the plot processor: a recorded set, a live FrameSet, or image files, as
+// the per-head images it takes (in the order of the calibration's heads), and where a session's
 // calibration is. Cameras are found by the rig layout's names ("bottom_left"); one that is
 // absent, not ok or unreadable leaves its image empty and says why in `problems` (the cloud then
 // leaves the head out and names it).
@@ -29,6 +29,12 @@ std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,
                                                       const std::vector<std::string>& camera_names,
                                                       const cloud::RigCalibration& rig,
                                                       std::vector<std::string>& problems);
+
+// The frames of image files (8-bit raw in the rig's pixel format, or BGR), two per head: L1, R1,
+// L2, R2, … in the order of the rig's heads. Unlike a recorded set, every file must be there: the
+// error names the one that cannot be read, or says how many files the rig needs.
+core::Result<std::vector<cloud::HeadFrames>> headFramesFromImageFiles(
+    const std::vector<std::string>& files, const cloud::RigCalibration& rig);
 
 // `explicit_dir` when given, else the session's calibration reference named "calib_dir"
 // (relative to the session folder unless absolute); nullopt when neither exists.

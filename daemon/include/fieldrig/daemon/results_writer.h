@@ -48,6 +48,16 @@ std::optional<std::pair<double, double>> plotPosition(const std::optional<std::s
 // partial, traits (traits::traitsToJson without slices and timings), problems.
 nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::PlotResult& result);
 
+// The files of a results folder.
+struct ResultsFiles {
+  std::filesystem::path jsonl, csv, geojson;
+};
+ResultsFiles resultsFiles(const std::filesystem::path& dir);
+
+// Removes the results files from `dir` (nothing else in it), so that the next run does every set
+// again instead of resuming.
+void removeResults(const std::filesystem::path& dir);
+
 struct ResultsOptions {
   bool csv = true;
   bool geojson = true;

@@ -29,6 +29,11 @@ struct SessionProcessingOptions {
   std::optional<std::filesystem::path> clouds_dir;
 };
 
+// Where a run writes its results unless told: SESSION/results, and one shard of several
+// SESSION/results/shard-K-of-N, so that shards never write the same file.
+std::filesystem::path defaultResultsDir(const std::filesystem::path& session_dir,
+                                        const SessionProcessingOptions& options);
+
 struct SessionProcessingSummary {
   std::size_t sets = 0;  // processed by this run
   std::size_t ok = 0;    // of those, with traits status ok

@@ -43,6 +43,14 @@ struct VerifyReport {
   bool ok() const { return problems.empty(); }
 };
 
+// The index counted: sets (complete or not) and their frames (ok or not).
+struct SessionCounts {
+  std::uint64_t sets = 0;
+  std::uint64_t complete_sets = 0;
+  std::uint64_t frames = 0;
+  std::uint64_t frames_not_ok = 0;
+};
+
 // Thread contract: thread-compatible; once opened, its const members may be used from any
 // number of threads at once.
 class SessionReader {
@@ -60,6 +68,11 @@ class SessionReader {
   const IndexedSet* byTriggerId(std::uint64_t trigger_id) const;
   // Every pass over a location (a plot may be imaged again on a later pass), in index order.
   std::vector<const IndexedSet*> byLocationId(std::string_view location_id) const;
+
+  SessionCounts counts() const;
+  // Bytes of every regular file below the session folder (frames, index, metadata, and whatever
+  // else was stored beside them), as found now; unreadable entries count nothing.
+  std::uint64_t bytesOnDisk() const;
 
   // The frame's image; an error names the file when it is absent, unreadable or not the PGM the
   // index describes.

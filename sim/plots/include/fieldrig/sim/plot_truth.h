@@ -7,6 +7,9 @@
 
 #include <Eigen/Core>
 
+#include <nlohmann/json.hpp>
+#include <vector>
+
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/traits/plot_traits.h"
 
@@ -20,5 +23,14 @@ struct PlotTruthTraits {
 
 PlotTruthTraits plotTruth(const PlotCloud& plot, traits::TraitsOptions options,
                           const Eigen::Vector3f& grid_offset = Eigen::Vector3f::Zero());
+
+// The truth as one JSON object (`fieldrig traits synth --truth`): plotTruth's definitions, its
+// visible area and VAI, then the generator's own truth (ground, base depth, areas, plants).
+nlohmann::ordered_json plotTruthJson(const PlotCloud& plot, const traits::TraitsOptions& options);
+
+// The observed points as computeTraits takes them in `frame`: the plot frame as generated, or the
+// camera frame that `options.camera_to_plot` turns into the plot frame.
+std::vector<Eigen::Vector3f> observedPoints(const PlotCloud& plot, traits::InputFrame frame,
+                                            const traits::TraitsOptions& options);
 
 }  // namespace fieldrig::sim
