@@ -164,7 +164,8 @@ stereo::StereoCalibration deepCopy(const stereo::StereoCalibration& c) {
 }
 
 // A calibration that loaded before and made `disparity` match garbage: now refused, naming the
-// file and the field.
+// file and the field. Out-of-range matcher options name the flag and its range (before: a
+// cv::Exception abort for --num-disparities 100000, hours of matching for --block-size 9999).
 TEST(StereoCli, UnusableCalibrationAndOptionsNameTheCulprit) {
   ScopedTempDir dir("stereo_cli_unusable");
   const std::string left = kData + "opencv_calib/left01.jpg";
@@ -215,6 +216,20 @@ TEST(StereoCli, UnusableCalibrationAndOptionsNameTheCulprit) {
                                  ": field 'T': baseline 80 m is implausible"),
             std::string::npos)
       << millimetres.err;
+
+  const std::pair<std::vector<std::string>, std::string> options[] = {
+      {{"--num-disparities", "100000"},
+       "--num-disparities 100000 is outside the allowed range [16, 1024] (a multiple of 16)"},
+      {{"--num-disparities", "0"},
+       "--num-disparities 0 is outside the allowed range [16, 1024] (a multiple of 16)"},
+      {{"--block-size", "9999"}, "--block-size 9999 is outside the allowed range [1, 31] (odd)"},
+      {{"--block-size", "4"}, "--block-size 4 is outside the allowed range [1, 31] (odd)"},
+  };
+  for (const auto& [extra, message] : options) {
+    const auto run = disparityWith(good, extra);
+    EXPECT_EQ(run.exit_code, 2) << extra[0] << " " << extra[1];
+    EXPECT_EQ(run.err, "fieldrig disparity: " + message + "\n");
+  }
 }
 
 // Ideal pinhole head (1624×1224, f = `focal`, 0.12 m), rectified by stereoRectify.

@@ -40,12 +40,13 @@ int runDisparity(const DisparityArgs& args) {
               << " but the left image is " << left.cols << "x" << left.rows << '\n';
     return kExitBadInput;
   }
-  if (args.num_disparities <= 0 || args.num_disparities % 16 != 0) {
-    std::cerr << who << "--num-disparities must be a positive multiple of 16\n";
-    return kExitBadInput;
-  }
-  if (args.block_size < 1 || args.block_size % 2 == 0) {
-    std::cerr << who << "--block-size must be odd\n";
+  stereo::MatcherOptions options;
+  options.num_disparities = args.num_disparities;
+  options.block_size = args.block_size;
+  options.wls = args.wls;
+  options.lr_check = args.lr_check;
+  if (auto valid = stereo::validate(options, stereo::OptionNames::kCommandLineFlags); !valid) {
+    std::cerr << who << valid.error().message << '\n';
     return kExitBadInput;
   }
   if (args.intrinsics.empty() != args.extrinsics.empty()) {
@@ -69,11 +70,6 @@ int runDisparity(const DisparityArgs& args) {
       return kExitBadInput;
     }
   }
-  stereo::MatcherOptions options;
-  options.num_disparities = args.num_disparities;
-  options.block_size = args.block_size;
-  options.wls = args.wls;
-  options.lr_check = args.lr_check;
   auto result =
       stereo::computePairDisparity(left, right, calibration ? &*calibration : nullptr, options);
   if (!result) {

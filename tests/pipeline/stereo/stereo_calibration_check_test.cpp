@@ -1,6 +1,7 @@
 // Calibrations are checked when loaded: each kind of unusable value (singular or implausible camera
 // matrix, non-rotation, zero or implausible baseline, broken projections, bad image size) is
 // refused with the file and the field named; what OpenCV's tools and ours write still loads.
+// The matcher options' ranges, shared by the configuration, the cloud options and the CLI.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,9 @@
 #include <string>
 
 #include "fieldrig/stereo/calibration.h"
+#include "fieldrig/stereo/head.h"
+#include "fieldrig/stereo/matcher.h"
+#include "fieldrig/stereo/pair_disparity.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig::stereo {
@@ -206,6 +210,79 @@ TEST(CalibrationCheck, BadImageSize) {
   ASSERT_FALSE(one_missing);
   EXPECT_EQ(one_missing.error().message,
             intrinsics.string() + ": field 'image_width' is missing (the other one is given)");
+}
+
+// ---- Matcher options ----------------------------------------------------------------------------
+
+void expectOptionRefused(const std::function<void(MatcherOptions&)>& change,
+                         const std::string& message) {
+  MatcherOptions options;
+  change(options);
+  const core::Result<void> valid = validate(options);
+  ASSERT_FALSE(valid) << "accepted; expected " << message;
+  EXPECT_EQ(valid.error().message, message);
+}
+
+TEST(MatcherOptionsCheck, DefaultsAndTheShippedValuesPass) {
+  EXPECT_TRUE(validate(MatcherOptions{}));
+  MatcherOptions widest;
+  widest.num_disparities = kMaxNumDisparities;
+  widest.min_disparity = kMaxMinDisparity;
+  widest.block_size = kMaxBlockSize;
+  widest.match_colour = true;
+  widest.p2_per_pixel = kMaxPenaltyPerPixel;
+  EXPECT_TRUE(validate(widest));
+}
+
+TEST(MatcherOptionsCheck, EachOutOfRangeOptionIsNamedWithItsRange) {
+  expectOptionRefused([](auto& o) { o.num_disparities = 100000; },
+                      "num_disparities 100000 is outside the allowed range [16, 1024] (a multiple "
+                      "of 16)");
+  expectOptionRefused([](auto& o) { o.num_disparities = 100; },
+                      "num_disparities 100 is outside the allowed range [16, 1024] (a multiple "
+                      "of 16)");
+  expectOptionRefused([](auto& o) { o.min_disparity = -5000; },
+                      "min_disparity -5000 is outside the allowed range [-1024, 1023]");
+  expectOptionRefused([](auto& o) { o.block_size = 9999; },
+                      "block_size 9999 is outside the allowed range [1, 31] (odd)");
+  expectOptionRefused([](auto& o) { o.block_size = 4; },
+                      "block_size 4 is outside the allowed range [1, 31] (odd)");
+  expectOptionRefused([](auto& o) { o.p2_per_pixel = 2000000000; },
+                      "p2_per_pixel 2000000000 is outside the allowed range [0, 1000]");
+  expectOptionRefused([](auto& o) { o.pre_filter_cap = 200; },
+                      "pre_filter_cap 200 is outside the allowed range [0, 63]");
+  expectOptionRefused([](auto& o) { o.uniqueness_ratio = -1; },
+                      "uniqueness_ratio -1 is outside the allowed range [0, 100]");
+  expectOptionRefused([](auto& o) { o.speckle_range = 1 << 30; },
+                      "speckle_range 1073741824 is outside the allowed range [0, 1024]");
+  expectOptionRefused([](auto& o) { o.lr_max_diff = std::numeric_limits<float>::quiet_NaN(); },
+                      "lr_max_diff nan is outside the allowed range [0, ...) pixels, finite");
+  expectOptionRefused([](auto& o) { o.wls_sigma = 0; },
+                      "wls_sigma 0 is outside the allowed range (0, ...), finite");
+  expectOptionRefused([](auto& o) { o.mode = 7; },
+                      "mode 7 is outside the allowed range (sgbm, hh, sgbm_3way or hh4)");
+}
+
+TEST(MatcherOptionsCheck, CommandLineNamesAreFlags) {
+  MatcherOptions options;
+  options.block_size = 9999;
+  const core::Result<void> valid = validate(options, OptionNames::kCommandLineFlags);
+  ASSERT_FALSE(valid);
+  EXPECT_EQ(valid.error().message, "--block-size 9999 is outside the allowed range [1, 31] (odd)");
+}
+
+TEST(MatcherOptionsCheck, LibraryEntryPointsRefuseBeforeOpenCvSeesThem) {
+  MatcherOptions options;
+  options.num_disparities = 100000;  // cv::Exception inside StereoSGBM before the check
+  const cv::Mat image(48, 64, CV_8UC1, cv::Scalar(128));
+  auto pair = computePairDisparity(image, image, nullptr, options);
+  ASSERT_FALSE(pair);
+  EXPECT_NE(pair.error().message.find("num_disparities 100000"), std::string::npos);
+  HeadOptions head_options;
+  head_options.matcher = options;
+  auto head = HeadPipeline::create(goodCalibration(), head_options);
+  ASSERT_FALSE(head);
+  EXPECT_NE(head.error().message.find("num_disparities 100000"), std::string::npos);
 }
 
 }  // namespace
