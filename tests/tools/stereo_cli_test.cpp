@@ -224,6 +224,9 @@ TEST(StereoCli, UnusableCalibrationAndOptionsNameTheCulprit) {
        "--num-disparities 0 is outside the allowed range [16, 1024] (a multiple of 16)"},
       {{"--block-size", "9999"}, "--block-size 9999 is outside the allowed range [1, 31] (odd)"},
       {{"--block-size", "4"}, "--block-size 4 is outside the allowed range [1, 31] (odd)"},
+      // 640-pixel-wide images: SGBM aborted on an empty buffer.
+      {{"--num-disparities", "640"},
+       "--num-disparities 640 leaves no column of the 640-pixel-wide images to match: at most 624"},
   };
   for (const auto& [extra, message] : options) {
     const auto run = disparityWith(good, extra);

@@ -45,7 +45,8 @@ int runDisparity(const DisparityArgs& args) {
   options.block_size = args.block_size;
   options.wls = args.wls;
   options.lr_check = args.lr_check;
-  if (auto valid = stereo::validate(options, stereo::OptionNames::kCommandLineFlags); !valid) {
+  if (auto valid = stereo::validate(options, left.size(), stereo::OptionNames::kCommandLineFlags);
+      !valid) {
     std::cerr << who << valid.error().message << '\n';
     return kExitBadInput;
   }

@@ -21,9 +21,9 @@ core::Result<HeadPipeline> HeadPipeline::create(const StereoCalibration& calibra
   if (calibration.image_size.empty()) {
     return core::Error{"calibration has no image size (image_width/image_height in intrinsics)"};
   }
-  if (auto valid = validate(options.matcher); !valid)
-    return core::Error{"matcher options: " + valid.error().message};
   const StereoCalibration scaled = calibration.scaled(options.scale);
+  if (auto valid = validate(options.matcher, scaled.image_size); !valid)
+    return core::Error{"matcher options: " + valid.error().message};
   core::Result<Rectifier> rectifier = Rectifier::create(scaled);
   if (!rectifier)
     return rectifier.error();

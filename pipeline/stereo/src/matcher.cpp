@@ -114,6 +114,25 @@ core::Result<void> validate(const MatcherOptions& options, OptionNames names) {
   return {};
 }
 
+core::Result<void> validate(const MatcherOptions& options, cv::Size matched_size,
+                            OptionNames names) {
+  if (auto valid = validate(options, names); !valid)
+    return valid;
+  // SGBM matches columns [max(maxD, 0), width + min(minD, 0)), maxD = minD + num.
+  const int limit = matched_size.width - std::max(options.min_disparity, 0);
+  if (options.num_disparities < limit)
+    return {};
+  std::ostringstream text;
+  text << optionName("num_disparities", names) << ' ' << options.num_disparities;
+  if (options.min_disparity != 0)
+    text << " (from " << optionName("min_disparity", names) << ' ' << options.min_disparity << ')';
+  text << " leaves no column of the " << matched_size.width << "-pixel-wide images to match";
+  const int largest = (limit - 1) / 16 * 16;
+  if (largest >= 16)
+    text << ": at most " << largest;
+  return core::Error{text.str()};
+}
+
 cv::Mat toFloatDisparity(const cv::Mat& fixed_point, int min_disparity) {
   cv::Mat out(fixed_point.size(), CV_32F);
   const int invalid_below = min_disparity * cv::StereoMatcher::DISP_SCALE;

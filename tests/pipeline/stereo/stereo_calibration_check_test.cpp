@@ -271,6 +271,29 @@ TEST(MatcherOptionsCheck, CommandLineNamesAreFlags) {
   EXPECT_EQ(valid.error().message, "--block-size 9999 is outside the allowed range [1, 31] (odd)");
 }
 
+// SGBM aborted (cv::Exception in its buffer) when the range left no column to match.
+TEST(MatcherOptionsCheck, TheRangeMustLeaveColumnsToMatch) {
+  MatcherOptions options;
+  options.num_disparities = 448;
+  EXPECT_TRUE(validate(options, cv::Size(450, 375)));
+  options.num_disparities = 464;
+  auto too_wide = validate(options, cv::Size(450, 375));
+  ASSERT_FALSE(too_wide);
+  EXPECT_EQ(too_wide.error().message,
+            "num_disparities 464 leaves no column of the 450-pixel-wide images to match: at most "
+            "448");
+  options.num_disparities = 16;
+  options.min_disparity = 440;
+  auto shifted = validate(options, cv::Size(450, 375), OptionNames::kCommandLineFlags);
+  ASSERT_FALSE(shifted);
+  EXPECT_EQ(shifted.error().message,
+            "--num-disparities 16 (from --min-disparity 440) leaves no column of the "
+            "450-pixel-wide images to match");
+  options.min_disparity = 0;
+  const cv::Mat narrow(8, 16, CV_8UC1, cv::Scalar(128));
+  EXPECT_FALSE(computePairDisparity(narrow, narrow, nullptr, options));
+}
+
 TEST(MatcherOptionsCheck, LibraryEntryPointsRefuseBeforeOpenCvSeesThem) {
   MatcherOptions options;
   options.num_disparities = 100000;  // cv::Exception inside StereoSGBM before the check

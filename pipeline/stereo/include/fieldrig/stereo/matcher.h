@@ -61,6 +61,11 @@ enum class OptionNames { kConfigKeys, kCommandLineFlags };
 // The error names the option and the allowed range.
 core::Result<void> validate(const MatcherOptions& options,
                             OptionNames names = OptionNames::kConfigKeys);
+// The same, and the disparity range leaves columns of an image of `matched_size` to match:
+// min_disparity + num_disparities < width (+ min_disparity when negative). Beyond it OpenCV's
+// SGBM aborts on an empty buffer (num_disparities 464 on a 450-pixel-wide pair).
+core::Result<void> validate(const MatcherOptions& options, cv::Size matched_size,
+                            OptionNames names = OptionNames::kConfigKeys);
 
 // Per-call timings of DisparityMatcher::compute, milliseconds.
 struct MatchTimings {
