@@ -621,6 +621,9 @@ void readMatcher(const Value& section, stereo::MatcherOptions& o) {
                               })},
               {"match_colour", flag(o.match_colour)},
           });
+  // The library's own ranges (and those across keys), so the file and the command line agree.
+  if (auto valid = stereo::validate(o); !valid)
+    section.fail(valid.error().message);
 }
 
 // The traits keys: the field names, as the JSON loader of earlier versions read them, so that

@@ -193,5 +193,36 @@ TEST(CloudCli, UnusableCalibrationIsAClearError) {
   EXPECT_NE(no_set.err.find("no set with index 7"), std::string::npos) << no_set.err;
 }
 
+// Implausible calibration values used to load and give an empty or distorted cloud with exit 0;
+// now `cloud` refuses them, naming the file and the field.
+TEST(CloudCli, ImplausibleCalibrationNamesFileAndField) {
+  ScopedTempDir dir("cloud_cli_implausible_calib");
+  writeSession(dir / "session", fixture().raw);
+  const auto cloudWith = [&](const RigCalibration& rig) {
+    EXPECT_TRUE(saveRigCalibration(rig, dir / "calib"));
+    return runFieldrig({"cloud", (dir / "session").string(), "--set", "0", "--calib",
+                        (dir / "calib").string(), "--out", (dir / "x.ply").string()},
+                       dir.path());
+  };
+  RigCalibration zero_camera = syntheticRig();
+  zero_camera.heads[1].stereo.M1 = cv::Mat::zeros(3, 3, CV_64F);
+  const CliRun singular = cloudWith(zero_camera);
+  EXPECT_EQ(singular.exit_code, 2);
+  EXPECT_NE(singular.err.find((dir / "calib" / "middle" / "intrinsics.yml").string() +
+                              ": field 'M1': singular camera matrix (fx = 0)"),
+            std::string::npos)
+      << singular.err;
+
+  RigCalibration reflected = syntheticRig();
+  reflected.heads[2].to_bottom(0, 0) = -1;
+  const CliRun reflection = cloudWith(reflected);
+  EXPECT_EQ(reflection.exit_code, 2);
+  EXPECT_NE(reflection.err.find((dir / "calib" / "rig.yml").string() +
+                                ": field 'top_to_bottom': not a rotation: a reflection"),
+            std::string::npos)
+      << reflection.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.ply"));
+}
+
 }  // namespace
 }  // namespace fieldrig::cloud

@@ -7,8 +7,8 @@
 #include <random>
 #include <sstream>
 
-#include "support/stem_campaign.h"
 #include "support/cli_run.h"
+#include "support/stem_campaign.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig {
@@ -91,6 +91,42 @@ TEST_F(StemCli, BadInputIsRefusedWithExitCode2AndAMessage) {
   const CliRun calibration = runFieldrig(bad_calibration, dir_.path());
   EXPECT_EQ(calibration.exit_code, 2);
   EXPECT_FALSE(calibration.err.empty());
+}
+
+// A copy with its own pixels: cv::Mat copies share them, and assigning a matrix expression to a
+// shared Mat writes into the original too.
+stereo::StereoCalibration deepCopy(const stereo::StereoCalibration& c) {
+  stereo::StereoCalibration out = c;
+  for (cv::Mat* m : {&out.M1, &out.D1, &out.M2, &out.D2, &out.R, &out.T, &out.R1, &out.R2, &out.P1,
+                     &out.P2, &out.Q})
+    *m = m->clone();
+  return out;
+}
+
+// A singular calibration used to load and the measurement then blamed the clicks; now the file
+// and the field are named before any image is read.
+TEST_F(StemCli, AnUnusableCalibrationIsNamedNotTheClicks) {
+  auto calibration = stereo::loadStereoCalibration(dir_.path());
+  ASSERT_TRUE(calibration) << calibration.error().message;
+  stereo::StereoCalibration zero_camera = deepCopy(*calibration);
+  zero_camera.M2 = cv::Mat::zeros(3, 3, CV_64F);
+  ASSERT_TRUE(stereo::saveStereoCalibration(zero_camera, dir_.path()));
+  const CliRun singular = runFieldrig(args(points_), dir_.path());
+  EXPECT_EQ(singular.exit_code, 2);
+  EXPECT_NE(singular.err.find((dir_ / "intrinsics.yml").string() +
+                              ": field 'M2': singular camera matrix (fx = 0)"),
+            std::string::npos)
+      << singular.err;
+
+  stereo::StereoCalibration zero_rotation = deepCopy(*calibration);
+  zero_rotation.R = cv::Mat::zeros(3, 3, CV_64F);
+  ASSERT_TRUE(stereo::saveStereoCalibration(zero_rotation, dir_.path()));
+  const CliRun not_rotation = runFieldrig(args(points_), dir_.path());
+  EXPECT_EQ(not_rotation.exit_code, 2);
+  EXPECT_NE(not_rotation.err.find((dir_ / "extrinsics.yml").string() +
+                                  ": field 'R': not a rotation: not orthonormal"),
+            std::string::npos)
+      << not_rotation.err;
 }
 
 TEST_F(StemCli, AWeakMatchExitsWith3AndSaysSo) {

@@ -153,6 +153,88 @@ TEST(StereoCli, BadInputIsAClearError) {
   EXPECT_NE(bad_board.err.find("--board '9by6' is not COLSxROWS"), std::string::npos);
 }
 
+// A copy with its own pixels: cv::Mat copies share them, and assigning a matrix expression to a
+// shared Mat writes into the original too.
+stereo::StereoCalibration deepCopy(const stereo::StereoCalibration& c) {
+  stereo::StereoCalibration out = c;
+  for (cv::Mat* m : {&out.M1, &out.D1, &out.M2, &out.D2, &out.R, &out.T, &out.R1, &out.R2, &out.P1,
+                     &out.P2, &out.Q})
+    *m = m->clone();
+  return out;
+}
+
+// A calibration that loaded before and made `disparity` match garbage: now refused, naming the
+// file and the field. Out-of-range matcher options name the flag and its range (before: a
+// cv::Exception abort for --num-disparities 100000, hours of matching for --block-size 9999).
+TEST(StereoCli, UnusableCalibrationAndOptionsNameTheCulprit) {
+  ScopedTempDir dir("stereo_cli_unusable");
+  const std::string left = kData + "opencv_calib/left01.jpg";
+  const std::string right = kData + "opencv_calib/right01.jpg";
+  const auto disparityWith = [&](const StereoCalibration& calibration,
+                                 std::vector<std::string> extra = {}) {
+    EXPECT_TRUE(saveStereoCalibration(calibration, dir.path()));
+    std::vector<std::string> args{"disparity",
+                                  "--left",
+                                  left,
+                                  "--right",
+                                  right,
+                                  "--intrinsics",
+                                  (dir / "intrinsics.yml").string(),
+                                  "--extrinsics",
+                                  (dir / "extrinsics.yml").string(),
+                                  "--out",
+                                  (dir / "d.pfm").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return runFieldrig(args, dir.path());
+  };
+  const StereoCalibration good = idealStereoCalibration(530, cv::Size(640, 480), 0.08);
+  ASSERT_EQ(disparityWith(good).exit_code, 0);
+
+  StereoCalibration zero_camera = deepCopy(good);
+  zero_camera.M1 = cv::Mat::zeros(3, 3, CV_64F);
+  const auto singular = disparityWith(zero_camera);
+  EXPECT_EQ(singular.exit_code, 2);
+  EXPECT_NE(singular.err.find((dir / "intrinsics.yml").string() +
+                              ": field 'M1': singular camera matrix (fx = 0)"),
+            std::string::npos)
+      << singular.err;
+
+  StereoCalibration zero_rotation = deepCopy(good);
+  zero_rotation.R1 = cv::Mat::zeros(3, 3, CV_64F);
+  const auto not_rotation = disparityWith(zero_rotation);
+  EXPECT_EQ(not_rotation.exit_code, 2);
+  EXPECT_NE(not_rotation.err.find((dir / "extrinsics.yml").string() +
+                                  ": field 'R1': not a rotation: not orthonormal"),
+            std::string::npos)
+      << not_rotation.err;
+
+  StereoCalibration in_millimetres = deepCopy(good);
+  in_millimetres.T *= 1000;
+  const auto millimetres = disparityWith(in_millimetres);
+  EXPECT_EQ(millimetres.exit_code, 2);
+  EXPECT_NE(millimetres.err.find((dir / "extrinsics.yml").string() +
+                                 ": field 'T': baseline 80 m is implausible"),
+            std::string::npos)
+      << millimetres.err;
+
+  const std::pair<std::vector<std::string>, std::string> options[] = {
+      {{"--num-disparities", "100000"},
+       "--num-disparities 100000 is outside the allowed range [16, 1024] (a multiple of 16)"},
+      {{"--num-disparities", "0"},
+       "--num-disparities 0 is outside the allowed range [16, 1024] (a multiple of 16)"},
+      {{"--block-size", "9999"}, "--block-size 9999 is outside the allowed range [1, 31] (odd)"},
+      {{"--block-size", "4"}, "--block-size 4 is outside the allowed range [1, 31] (odd)"},
+      // 640-pixel-wide images: SGBM aborted on an empty buffer.
+      {{"--num-disparities", "640"},
+       "--num-disparities 640 leaves no column of the 640-pixel-wide images to match: at most 624"},
+  };
+  for (const auto& [extra, message] : options) {
+    const auto run = disparityWith(good, extra);
+    EXPECT_EQ(run.exit_code, 2) << extra[0] << " " << extra[1];
+    EXPECT_EQ(run.err, "fieldrig disparity: " + message + "\n");
+  }
+}
+
 // Ideal pinhole head (1624×1224, f = `focal`, 0.12 m), rectified by stereoRectify.
 StereoCalibration idealHead(double focal) {
   StereoCalibration c;

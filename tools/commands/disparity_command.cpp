@@ -40,10 +40,14 @@ int runDisparity(const DisparityArgs& args) {
               << " but the left image is " << left.cols << "x" << left.rows << '\n';
     return kExitBadInput;
   }
-  if (args.num_disparities <= 0 || args.num_disparities % 16 != 0)
-    return fail(who, "--num-disparities must be a positive multiple of 16");
-  if (args.block_size < 1 || args.block_size % 2 == 0)
-    return fail(who, "--block-size must be odd");
+  stereo::MatcherOptions options;
+  options.num_disparities = args.num_disparities;
+  options.block_size = args.block_size;
+  options.wls = args.wls;
+  options.lr_check = args.lr_check;
+  if (auto valid = stereo::validate(options, left.size(), stereo::OptionNames::kCommandLineFlags);
+      !valid)
+    return fail(who, valid.error().message);
   if (args.intrinsics.empty() != args.extrinsics.empty())
     return fail(who, "--intrinsics and --extrinsics go together");
   std::optional<stereo::StereoCalibration> calibration;
@@ -61,11 +65,6 @@ int runDisparity(const DisparityArgs& args) {
       return kExitBadInput;
     }
   }
-  stereo::MatcherOptions options;
-  options.num_disparities = args.num_disparities;
-  options.block_size = args.block_size;
-  options.wls = args.wls;
-  options.lr_check = args.lr_check;
   auto result =
       stereo::computePairDisparity(left, right, calibration ? &*calibration : nullptr, options);
   if (!result)

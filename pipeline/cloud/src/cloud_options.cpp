@@ -9,10 +9,8 @@ core::Result<void> validate(const CloudOptions& options) {
   // Written as negations so that NaN fails every check.
   if (!(options.scale > 0 && options.scale <= 1))
     return Error{"scale " + std::to_string(options.scale) + " is not in (0, 1]"};
-  if (options.matcher.num_disparities <= 0 || options.matcher.num_disparities % 16 != 0) {
-    return Error{"matcher.num_disparities " + std::to_string(options.matcher.num_disparities) +
-                 " is not a positive multiple of 16"};
-  }
+  if (auto matcher = stereo::validate(options.matcher); !matcher)
+    return Error{"matcher." + matcher.error().message};
   if (!(options.min_depth_m >= 0 && options.max_depth_m > options.min_depth_m &&
         std::isfinite(options.max_depth_m))) {
     return Error{"the depth crop must satisfy 0 <= min_depth_m (" +

@@ -1,6 +1,7 @@
 #include "fieldrig/cloud/rig_calibration.h"
 
 #include <cmath>
+#include <sstream>
 
 #include "fieldrig/cloud/cloud_options.h"
 
@@ -24,9 +25,26 @@ bool readMatx(const cv::FileNode& node, int rows, int cols, cv::Mat& out) {
   return cv::checkRange(out);
 }
 
-bool isRotation(const cv::Matx33d& r) {
-  const cv::Matx33d should_be_identity = r * r.t();
-  return cv::norm(should_be_identity - cv::Matx33d::eye()) < 1e-3 && cv::determinant(r) > 0;
+// Heads ride on one rig: a head more than this far from the bottom one is a transform in
+// millimetres or a typo, and would put its points metres off without any other sign.
+constexpr double kMaxHeadOffsetM = 10.0;
+
+// A head's transform: rotation (stereo::checkRotation), bottom row (0 0 0 1), plausible offset.
+core::Result<void> checkHeadTransform(const cv::Matx44d& transform) {
+  if (auto rotation = stereo::checkRotation(transform.get_minor<3, 3>(0, 0)); !rotation)
+    return rotation;
+  if (transform(3, 0) != 0 || transform(3, 1) != 0 || transform(3, 2) != 0 ||
+      transform(3, 3) != 1) {
+    return Error{"not a rigid transform: its bottom row is not (0 0 0 1)"};
+  }
+  const double offset = cv::norm(cv::Vec3d(transform(0, 3), transform(1, 3), transform(2, 3)));
+  if (offset > kMaxHeadOffsetM) {
+    std::ostringstream text;
+    text << "the head is " << offset << " m from the bottom one (at most " << kMaxHeadOffsetM
+         << " m on one rig; rig.yml translations are in metres)";
+    return Error{text.str()};
+  }
+  return {};
 }
 
 }  // namespace
@@ -69,9 +87,8 @@ core::Result<RigCalibration> loadRigCalibration(const fs::path& directory) {
       return Error{file.string() + ": field '" + key + "' is not a finite 4x4 matrix"};
     } else {
       head.to_bottom = cv::Matx44d(transform);
-      const cv::Matx33d rotation = head.to_bottom.get_minor<3, 3>(0, 0);
-      if (!isRotation(rotation)) {
-        return Error{file.string() + ": field '" + key + "' does not hold a rotation"};
+      if (auto checked = checkHeadTransform(head.to_bottom); !checked) {
+        return Error{file.string() + ": field '" + key + "': " + checked.error().message};
       }
     }
     core::Result<stereo::StereoCalibration> calibration =
@@ -87,8 +104,11 @@ core::Result<RigCalibration> loadRigCalibration(const fs::path& directory) {
   }
   if (!storage["plot_rotation"].empty()) {
     cv::Mat rotation;
-    if (!readMatx(storage["plot_rotation"], 3, 3, rotation) || !isRotation(cv::Matx33d(rotation))) {
-      return Error{file.string() + ": field 'plot_rotation' is not a 3x3 rotation matrix"};
+    if (!readMatx(storage["plot_rotation"], 3, 3, rotation)) {
+      return Error{file.string() + ": field 'plot_rotation' is not a finite 3x3 matrix"};
+    }
+    if (auto checked = stereo::checkRotation(cv::Matx33d(rotation)); !checked) {
+      return Error{file.string() + ": field 'plot_rotation': " + checked.error().message};
     }
     rig.plot_rotation = cv::Matx33d(rotation);
   }

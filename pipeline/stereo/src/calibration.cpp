@@ -1,7 +1,11 @@
 #include "fieldrig/stereo/calibration.h"
 
+#include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <sstream>
 #include <string>
+#include <tuple>
+#include <utility>
 
 namespace fieldrig::stereo {
 namespace {
@@ -44,7 +48,178 @@ bool isDistortionLength(int n) {
   return n == 4 || n == 5 || n == 8 || n == 12 || n == 14;
 }
 
+// Six significant digits: enough to recognise the value in the file, without to_string's
+// "0.000000" for small ones.
+std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+Error fieldError(const std::string& field, const std::string& what) {
+  return Error{"field '" + field + "': " + what};
+}
+
+// M1/M2: [fx s cx; 0 fy cy; 0 0 1]. fx, fy > 0 make it invertible (det = fx·fy).
+core::Result<void> checkCameraMatrix(const cv::Mat& m, const std::string& field,
+                                     cv::Size image_size) {
+  const double fx = m.at<double>(0, 0);
+  const double fy = m.at<double>(1, 1);
+  const double cx = m.at<double>(0, 2);
+  const double cy = m.at<double>(1, 2);
+  for (const auto& [name, focal] : {std::pair{"fx", fx}, {"fy", fy}}) {
+    if (focal == 0)
+      return fieldError(field, std::string("singular camera matrix (") + name + " = 0)");
+    if (focal < 0) {
+      return fieldError(field, std::string(name) + " = " + number(focal) +
+                                   " is not a focal length (positive pixels)");
+    }
+  }
+  // Exact zeros and one are what every calibration tool writes; 1e-9 only forgives rounding.
+  constexpr double kExact = 1e-9;
+  if (std::abs(m.at<double>(1, 0)) > kExact || std::abs(m.at<double>(2, 0)) > kExact ||
+      std::abs(m.at<double>(2, 1)) > kExact || std::abs(m.at<double>(2, 2) - 1) > kExact) {
+    return fieldError(field,
+                      "is not a camera matrix [fx s cx; 0 fy cy; 0 0 1]: its lower part is [" +
+                          number(m.at<double>(1, 0)) + "; " + number(m.at<double>(2, 0)) + " " +
+                          number(m.at<double>(2, 1)) + " " + number(m.at<double>(2, 2)) + "]");
+  }
+  const double aspect = fx / fy;
+  if (aspect > kMaxFocalAspect || aspect < 1 / kMaxFocalAspect) {
+    return fieldError(field, "fx / fy = " + number(fx) + " / " + number(fy) +
+                                 " is implausible (pixels are not that far from square; allowed " +
+                                 number(1 / kMaxFocalAspect) + " to " + number(kMaxFocalAspect) +
+                                 ")");
+  }
+  const std::string principal_point = "principal point (" + number(cx) + ", " + number(cy) + ")";
+  if (image_size.empty()) {
+    if (!(cx > 0 && cy > 0))
+      return fieldError(field, principal_point + " is not inside any image");
+    return {};
+  }
+  const double margin_x = kPrincipalPointMargin * image_size.width;
+  const double margin_y = kPrincipalPointMargin * image_size.height;
+  if (cx < -margin_x || cx > image_size.width + margin_x || cy < -margin_y ||
+      cy > image_size.height + margin_y) {
+    return fieldError(field, principal_point + " lies outside the " +
+                                 std::to_string(image_size.width) + "x" +
+                                 std::to_string(image_size.height) + " image");
+  }
+  return {};
+}
+
+// Reads image_width/image_height: both or neither; whole, positive, within kMaxImageSide.
+core::Result<cv::Size> readImageSize(const cv::FileStorage& storage) {
+  const cv::FileNode width = storage["image_width"];
+  const cv::FileNode height = storage["image_height"];
+  if (width.empty() && height.empty())
+    return cv::Size();
+  if (width.empty() || height.empty()) {
+    return Error{std::string("field '") + (width.empty() ? "image_width" : "image_height") +
+                 "' is missing (the other one is given)"};
+  }
+  cv::Size size;
+  for (const auto& [name, node, side] :
+       {std::tuple{"image_width", width, &size.width}, {"image_height", height, &size.height}}) {
+    if (!node.isInt())
+      return fieldError(name, "is not a whole number of pixels");
+    *side = static_cast<int>(node);
+    if (*side <= 0 || *side > kMaxImageSide) {
+      return fieldError(name, std::to_string(*side) + " is outside 1.." +
+                                  std::to_string(kMaxImageSide) + " pixels");
+    }
+  }
+  return size;
+}
+
+core::Result<void> withFile(const std::filesystem::path& file, core::Result<void> checked) {
+  if (checked)
+    return {};
+  return Error{file.string() + ": " + checked.error().message};
+}
+
 }  // namespace
+
+core::Result<void> checkRotation(const cv::Matx33d& rotation) {
+  const double off = cv::norm(rotation * rotation.t() - cv::Matx33d::eye());
+  if (!(off <= kRotationTolerance)) {
+    return Error{"not a rotation: not orthonormal (|R*R^T - I| = " + number(off) + " > " +
+                 number(kRotationTolerance) + ")"};
+  }
+  const double det = cv::determinant(rotation);
+  if (det < 0)
+    return Error{"not a rotation: a reflection (det = " + number(det) + ")"};
+  return {};
+}
+
+core::Result<void> checkIntrinsics(const StereoCalibration& calibration) {
+  const cv::Size size = calibration.image_size;
+  if (!size.empty() && (size.width <= 0 || size.height <= 0 || size.width > kMaxImageSide ||
+                        size.height > kMaxImageSide)) {
+    return Error{"image size " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+                 " is outside 1.." + std::to_string(kMaxImageSide) + " pixels a side"};
+  }
+  for (const auto& [field, matrix] : {std::pair{"M1", calibration.M1}, {"M2", calibration.M2}}) {
+    if (matrix.rows != 3 || matrix.cols != 3 || matrix.type() != CV_64F)
+      return fieldError(field, "is not a 3x3 matrix of doubles");
+    if (!cv::checkRange(matrix))
+      return fieldError(field, "holds NaN or infinite values");
+    if (auto checked = checkCameraMatrix(matrix, field, size); !checked)
+      return checked;
+  }
+  for (const auto& [field, matrix] : {std::pair{"D1", calibration.D1}, {"D2", calibration.D2}}) {
+    if (!cv::checkRange(matrix))
+      return fieldError(field, "holds NaN or infinite values");
+  }
+  return {};
+}
+
+core::Result<void> checkExtrinsics(const StereoCalibration& calibration) {
+  const std::pair<const char*, const cv::Mat*> all[] = {
+      {"R", &calibration.R},   {"T", &calibration.T},   {"R1", &calibration.R1},
+      {"R2", &calibration.R2}, {"P1", &calibration.P1}, {"P2", &calibration.P2},
+      {"Q", &calibration.Q}};
+  for (const auto& [field, matrix] : all) {
+    if (matrix->empty() || matrix->type() != CV_64F)
+      return fieldError(field, "is missing or not a matrix of doubles");
+    if (!cv::checkRange(*matrix))
+      return fieldError(field, "holds NaN or infinite values");
+  }
+  for (const auto& [field, matrix] :
+       {std::pair{"R", calibration.R}, {"R1", calibration.R1}, {"R2", calibration.R2}}) {
+    if (auto rotation = checkRotation(cv::Matx33d(matrix)); !rotation)
+      return fieldError(field, rotation.error().message);
+  }
+  const double baseline = calibration.baseline();
+  if (baseline == 0)
+    return fieldError("T", "zero baseline (the two cameras are at one place)");
+  if (baseline < kMinBaselineM || baseline > kMaxBaselineM) {
+    return fieldError("T", "baseline " + number(baseline) + " m is implausible (allowed " +
+                               number(kMinBaselineM) + " to " + number(kMaxBaselineM) +
+                               " m; T is in metres)");
+  }
+  for (const auto& [field, matrix] : {std::pair{"P1", calibration.P1}, {"P2", calibration.P2}}) {
+    const double focal = matrix.at<double>(0, 0);
+    if (!(focal > 0) || !(matrix.at<double>(1, 1) > 0)) {
+      return fieldError(field, "rectified focal length (" + number(focal) + ", " +
+                                   number(matrix.at<double>(1, 1)) + ") is not positive");
+    }
+  }
+  // Q = [1 0 0 -cx; 0 1 0 -cy; 0 0 0 f; 0 0 -1/Tx (cx - cx')/Tx], Tx the rectified baseline,
+  // which is |T|: rectification only rotates T onto the x (or y) axis.
+  const cv::Mat& q = calibration.Q;
+  if (q.at<double>(2, 3) == 0)
+    return fieldError("Q", "singular: Q(2,3), the rectified focal length, is 0");
+  if (q.at<double>(3, 2) == 0)
+    return fieldError("Q", "singular: Q(3,2), -1/baseline, is 0");
+  const double q_baseline = 1 / std::abs(q.at<double>(3, 2));
+  // 1 %: far above rounding, far below the difference between two heads' calibrations.
+  if (std::abs(q_baseline - baseline) > 0.01 * baseline) {
+    return fieldError("Q", "its baseline (1/|Q(3,2)| = " + number(q_baseline) + " m) is not T's (" +
+                               number(baseline) + " m): Q and T come from different calibrations");
+  }
+  return {};
+}
 
 double StereoCalibration::baseline() const {
   return cv::norm(T);
@@ -130,13 +305,12 @@ core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::pat
                      std::to_string(matrix.cols) + " coefficients; expected 4, 5, 8, 12 or 14"};
       }
     }
-    int width = 0;
-    int height = 0;
-    if (!storage["image_width"].empty())
-      storage["image_width"] >> width;
-    if (!storage["image_height"].empty())
-      storage["image_height"] >> height;
-    calibration.image_size = cv::Size(width, height);
+    core::Result<cv::Size> image_size = readImageSize(storage);
+    if (!image_size)
+      return Error{intrinsics.string() + ": " + image_size.error().message};
+    calibration.image_size = *image_size;
+    if (auto checked = withFile(intrinsics, checkIntrinsics(calibration)); !checked)
+      return checked.error();
   }
   {
     cv::FileStorage storage;
@@ -163,9 +337,8 @@ core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::pat
       return Error{error};
     }
   }
-  if (calibration.baseline() <= 0) {
-    return Error{extrinsics.string() + ": field 'T' gives a zero baseline"};
-  }
+  if (auto checked = withFile(extrinsics, checkExtrinsics(calibration)); !checked)
+    return checked.error();
   return calibration;
 }
 

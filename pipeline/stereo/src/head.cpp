@@ -21,11 +21,9 @@ core::Result<HeadPipeline> HeadPipeline::create(const StereoCalibration& calibra
   if (calibration.image_size.empty()) {
     return core::Error{"calibration has no image size (image_width/image_height in intrinsics)"};
   }
-  if (options.matcher.num_disparities <= 0 || options.matcher.num_disparities % 16 != 0) {
-    return core::Error{"num_disparities " + std::to_string(options.matcher.num_disparities) +
-                       " is not a positive multiple of 16"};
-  }
   const StereoCalibration scaled = calibration.scaled(options.scale);
+  if (auto valid = validate(options.matcher, scaled.image_size); !valid)
+    return core::Error{"matcher options: " + valid.error().message};
   core::Result<Rectifier> rectifier = Rectifier::create(scaled);
   if (!rectifier)
     return rectifier.error();

@@ -1,9 +1,14 @@
 #include "fieldrig/stereo/matcher.h"
 #include "fieldrig/core/time.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <utility>
 
 namespace fieldrig::stereo {
 namespace {
@@ -43,7 +48,90 @@ cv::Mat rightViewToFloat(const cv::Mat& fixed_point, const MatcherOptions& optio
   return out;
 }
 
+std::string optionName(std::string_view key, OptionNames names) {
+  if (names == OptionNames::kConfigKeys)
+    return std::string(key);
+  std::string flag = "--" + std::string(key);
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  return flag;
+}
+
 }  // namespace
+
+core::Result<void> validate(const MatcherOptions& options, OptionNames names) {
+  using core::Error;
+  const auto outside = [&](std::string_view key, auto value, const std::string& allowed) {
+    std::ostringstream text;
+    text << optionName(key, names) << ' ' << value << " is outside the allowed range " << allowed;
+    return Error{text.str()};
+  };
+  const auto range = [](auto lo, auto hi) {
+    std::ostringstream text;
+    text << '[' << lo << ", " << hi << ']';
+    return text.str();
+  };
+  if (options.num_disparities < 16 || options.num_disparities > kMaxNumDisparities ||
+      options.num_disparities % 16 != 0) {
+    return outside("num_disparities", options.num_disparities,
+                   range(16, kMaxNumDisparities) + " (a multiple of 16)");
+  }
+  if (options.min_disparity < kMinMinDisparity || options.min_disparity > kMaxMinDisparity) {
+    return outside("min_disparity", options.min_disparity,
+                   range(kMinMinDisparity, kMaxMinDisparity));
+  }
+  if (options.block_size < 1 || options.block_size > kMaxBlockSize || options.block_size % 2 == 0) {
+    return outside("block_size", options.block_size, range(1, kMaxBlockSize) + " (odd)");
+  }
+  for (const auto& [key, value] :
+       {std::pair{"p1_per_pixel", options.p1_per_pixel}, {"p2_per_pixel", options.p2_per_pixel}}) {
+    if (value < 0 || value > kMaxPenaltyPerPixel)
+      return outside(key, value, range(0, kMaxPenaltyPerPixel));
+  }
+  if (options.pre_filter_cap < 0 || options.pre_filter_cap > kMaxPreFilterCap)
+    return outside("pre_filter_cap", options.pre_filter_cap, range(0, kMaxPreFilterCap));
+  if (options.uniqueness_ratio < 0 || options.uniqueness_ratio > 100)
+    return outside("uniqueness_ratio", options.uniqueness_ratio, range(0, 100));
+  if (options.speckle_window < 0)
+    return outside("speckle_window", options.speckle_window, "[0, ...) pixels");
+  // SGBM multiplies the range by 16 (its fixed point); beyond the disparity range it means nothing.
+  if (options.speckle_range < 0 || options.speckle_range > kMaxNumDisparities)
+    return outside("speckle_range", options.speckle_range, range(0, kMaxNumDisparities));
+  if (options.disp12_max_diff < -1 || options.disp12_max_diff > kMaxNumDisparities) {
+    return outside("disp12_max_diff", options.disp12_max_diff,
+                   range(-1, kMaxNumDisparities) + " (-1 disables it)");
+  }
+  // Written as negations so that NaN fails them.
+  if (!(options.lr_max_diff >= 0 && std::isfinite(options.lr_max_diff)))
+    return outside("lr_max_diff", options.lr_max_diff, "[0, ...) pixels, finite");
+  if (!(options.wls_lambda >= 0 && std::isfinite(options.wls_lambda)))
+    return outside("wls_lambda", options.wls_lambda, "[0, ...), finite");
+  if (!(options.wls_sigma > 0 && std::isfinite(options.wls_sigma)))
+    return outside("wls_sigma", options.wls_sigma, "(0, ...), finite");
+  if (options.mode != cv::StereoSGBM::MODE_SGBM && options.mode != cv::StereoSGBM::MODE_HH &&
+      options.mode != cv::StereoSGBM::MODE_SGBM_3WAY && options.mode != cv::StereoSGBM::MODE_HH4) {
+    return outside("mode", options.mode, "(sgbm, hh, sgbm_3way or hh4)");
+  }
+  return {};
+}
+
+core::Result<void> validate(const MatcherOptions& options, cv::Size matched_size,
+                            OptionNames names) {
+  if (auto valid = validate(options, names); !valid)
+    return valid;
+  // SGBM matches columns [max(maxD, 0), width + min(minD, 0)), maxD = minD + num.
+  const int limit = matched_size.width - std::max(options.min_disparity, 0);
+  if (options.num_disparities < limit)
+    return {};
+  std::ostringstream text;
+  text << optionName("num_disparities", names) << ' ' << options.num_disparities;
+  if (options.min_disparity != 0)
+    text << " (from " << optionName("min_disparity", names) << ' ' << options.min_disparity << ')';
+  text << " leaves no column of the " << matched_size.width << "-pixel-wide images to match";
+  const int largest = (limit - 1) / 16 * 16;
+  if (largest >= 16)
+    text << ": at most " << largest;
+  return core::Error{text.str()};
+}
 
 cv::Mat toFloatDisparity(const cv::Mat& fixed_point, int min_disparity) {
   cv::Mat out(fixed_point.size(), CV_32F);

@@ -11,6 +11,8 @@ core::Result<PairDisparity> computePairDisparity(const cv::Mat& left, const cv::
                                                  const StereoCalibration* calibration,
                                                  const MatcherOptions& options) {
   CV_Assert(left.size() == right.size());
+  if (auto valid = validate(options, left.size()); !valid)
+    return valid.error();
   cv::Mat left_matched = left, right_matched = right;
   if (calibration != nullptr) {
     CV_Assert(calibration->image_size == left.size());

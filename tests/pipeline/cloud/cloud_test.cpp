@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <vector>
 
 #include "fieldrig/cloud/fusion.h"
@@ -198,9 +199,56 @@ TEST(Rig, ErrorsNameFileAndField) {
   }
   auto not_rotation = loadRigCalibration(dir.path());
   ASSERT_FALSE(not_rotation);
-  EXPECT_EQ(
-      not_rotation.error().message,
-      (dir.path() / "rig.yml").string() + ": field 'plot_rotation' is not a 3x3 rotation matrix");
+  EXPECT_EQ(not_rotation.error().message,
+            (dir.path() / "rig.yml").string() +
+                ": field 'plot_rotation': not a rotation: not orthonormal (|R*R^T - I| = 3 > "
+                "0.001)");
+}
+
+// Each kind of unusable head transform is refused naming rig.yml and the field; a head's own
+// unusable calibration names its file (before, all of these loaded).
+TEST(Rig, HeadTransformsAndHeadCalibrationsAreChecked) {
+  ScopedTempDir dir("cloud_rig_checks");
+  const std::string rig_file = (dir.path() / "rig.yml").string();
+  const auto loadChanged = [&](const std::function<void(RigCalibration&)>& change) {
+    RigCalibration rig = syntheticRig();
+    change(rig);
+    EXPECT_TRUE(saveRigCalibration(rig, dir.path()));
+    return loadRigCalibration(dir.path());
+  };
+  const auto expectRefused = [](const core::Result<RigCalibration>& loaded,
+                                const std::string& message) {
+    ASSERT_FALSE(loaded) << "accepted; expected " << message;
+    EXPECT_EQ(loaded.error().message.rfind(message, 0), 0u) << loaded.error().message;
+  };
+  expectRefused(loadChanged([](RigCalibration& rig) {
+                  for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c)
+                      rig.heads[1].to_bottom(r, c) = 0;
+                }),
+                rig_file + ": field 'middle_to_bottom': not a rotation: not orthonormal");
+  expectRefused(loadChanged([](RigCalibration& rig) { rig.heads[2].to_bottom(0, 0) = -1; }),
+                rig_file + ": field 'top_to_bottom': not a rotation: a reflection (det = -1)");
+  expectRefused(loadChanged([](RigCalibration& rig) { rig.heads[1].to_bottom(3, 1) = 0.5; }),
+                rig_file + ": field 'middle_to_bottom': not a rigid transform");
+  // A rig measured in millimetres.
+  expectRefused(loadChanged([](RigCalibration& rig) { rig.heads[2].to_bottom(1, 3) = -1500; }),
+                rig_file + ": field 'top_to_bottom': the head is 1500 m from the bottom one");
+  expectRefused(loadChanged([](RigCalibration& rig) { rig.plot_rotation(2, 2) = -1; }),
+                rig_file + ": field 'plot_rotation': not a rotation: a reflection");
+  expectRefused(loadChanged([](RigCalibration& rig) {
+                  rig.heads[1].stereo.M1 = cv::Mat::zeros(3, 3, CV_64F);
+                }),
+                (dir.path() / "middle" / "intrinsics.yml").string() +
+                    ": field 'M1': singular camera matrix (fx = 0)");
+  expectRefused(loadChanged([](RigCalibration& rig) {
+                  rig.heads[0].stereo.R = cv::Mat::zeros(3, 3, CV_64F);
+                }),
+                (dir.path() / "bottom" / "extrinsics.yml").string() +
+                    ": field 'R': not a rotation: not orthonormal");
+  // The synthetic rig itself, as sim and `fieldrig sim plots` write it, loads.
+  auto good = loadChanged([](RigCalibration&) {});
+  EXPECT_TRUE(good) << good.error().message;
 }
 
 // Calibrations written before the processing options left rig.yml carry them at their defaults:

@@ -34,7 +34,41 @@ struct StereoCalibration {
 // rendered scenes and synthetic rigs.
 StereoCalibration idealStereoCalibration(double focal_px, cv::Size image_size, double baseline_m);
 
-// Reads the two files; the error names the file and the missing or malformed field.
+// Whether the values are usable, not only well-formed: OpenCV rectifies and reprojects with any
+// finite matrix without complaint, so a singular camera matrix or a zeroed rotation would turn
+// into empty disparity maps and wrong sizes far from the file that caused them. Each check's error
+// names the field ("field 'M1': singular camera matrix (fx = 0)"); the loader adds the file.
+//   checkIntrinsics: M1, M2 are [fx s cx; 0 fy cy; 0 0 1] with fx, fy > 0 (hence invertible),
+//     fx/fy within [1/kMaxFocalAspect, kMaxFocalAspect], the principal point inside the image
+//     (kPrincipalPointMargin of its size outside is tolerated) or, without an image size, at
+//     positive coordinates; D1, D2 finite; the image size, when given, positive and within what
+//     cv::remap addresses (kMaxImageSide).
+//   checkExtrinsics: R, R1, R2 rotations (checkRotation); T a baseline in [kMinBaselineM,
+//     kMaxBaselineM]; P1, P2 finite with a positive rectified focal length; Q reprojecting
+//     (Q(2,3) = f != 0) with the baseline T gives.
+core::Result<void> checkIntrinsics(const StereoCalibration& calibration);
+core::Result<void> checkExtrinsics(const StereoCalibration& calibration);
+
+// A rotation is orthonormal, ||R·Rᵀ − I|| (Frobenius) <= kRotationTolerance, with det +1 (not a
+// reflection). The error says which, with the measured value.
+core::Result<void> checkRotation(const cv::Matx33d& rotation);
+
+// 1e-3: OpenCV writes 17 significant digits (errors ~1e-15), and rotations copied by hand with 4
+// or more digits stay below 1e-3; a matrix further off is not a rotation but a mistake, and
+// would skew geometry by more than a milliradian.
+inline constexpr double kRotationTolerance = 1e-3;
+// Square pixels give 1; anamorphic optics stay well inside 2. Beyond it a value was mistyped.
+inline constexpr double kMaxFocalAspect = 2.0;
+inline constexpr double kPrincipalPointMargin = 0.1;
+// cv::remap takes the rectification maps as 16-bit coordinates.
+inline constexpr int kMaxImageSide = 32767;
+// |T| is in metres: a baseline over 10 m is a calibration in millimetres (a board square given
+// in mm), one under 1 mm a zeroed or mistyped T.
+inline constexpr double kMinBaselineM = 1e-3;
+inline constexpr double kMaxBaselineM = 10.0;
+
+// Reads the two files and checks them (checkIntrinsics, checkExtrinsics); the error names the
+// file and the missing, malformed or implausible field.
 core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::path& intrinsics,
                                                       const std::filesystem::path& extrinsics);
 // Reads DIR/intrinsics.yml and DIR/extrinsics.yml.

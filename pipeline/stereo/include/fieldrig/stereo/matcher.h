@@ -7,6 +7,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/ximgproc/disparity_filter.hpp>
 
+#include "fieldrig/core/result.h"
+
 namespace fieldrig::stereo {
 
 // Disparities below this value mark invalid pixels in every float map this library returns.
@@ -36,6 +38,34 @@ struct MatcherOptions {
   int mode = cv::StereoSGBM::MODE_SGBM_3WAY;
   bool match_colour = false;  // true: SGBM on BGR (3 channels), false: on grey
 };
+
+// The ranges validate() enforces, each with its reason:
+// - disparities: SGBM returns 16-bit fixed point (×16), so min + num must stay below 2048; a range
+//   of 1024 pixels is beyond any pair at field resolution, and the cost volume grows with it.
+inline constexpr int kMaxNumDisparities = 1024;
+inline constexpr int kMinMinDisparity = -1024;
+inline constexpr int kMaxMinDisparity = 1023;
+// - block: OpenCV suggests 3..11; matching time grows with the block (9999 ran for hours), and
+//   P1/P2 = per_pixel · channels · block² must not overflow an int.
+inline constexpr int kMaxBlockSize = 31;
+inline constexpr int kMaxPenaltyPerPixel = 1000;
+// - pre_filter_cap: OpenCV's own limit (StereoBM's; SGBM keeps the clipped values in 8 bits).
+inline constexpr int kMaxPreFilterCap = 63;
+
+// How validate() names an option in its errors: the configuration key ("num_disparities") or the
+// `fieldrig disparity` flag ("--num-disparities").
+enum class OptionNames { kConfigKeys, kCommandLineFlags };
+
+// Every option finite and inside its range (above), checked before OpenCV sees it: out of range,
+// OpenCV throws (num_disparities 100000), runs for hours (block_size 9999) or silently clamps.
+// The error names the option and the allowed range.
+core::Result<void> validate(const MatcherOptions& options,
+                            OptionNames names = OptionNames::kConfigKeys);
+// The same, and the disparity range leaves columns of an image of `matched_size` to match:
+// min_disparity + num_disparities < width (+ min_disparity when negative). Beyond it OpenCV's
+// SGBM aborts on an empty buffer (num_disparities 464 on a 450-pixel-wide pair).
+core::Result<void> validate(const MatcherOptions& options, cv::Size matched_size,
+                            OptionNames names = OptionNames::kConfigKeys);
 
 // Per-call timings of DisparityMatcher::compute, milliseconds.
 struct MatchTimings {

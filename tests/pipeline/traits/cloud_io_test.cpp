@@ -1,0 +1,227 @@
+// loadCloud never trusts a header: huge, truncated, garbage, empty and folder inputs are errors
+// naming the file (before: std::bad_alloc for a huge PLY or PCD count, a segfault inside PCL for
+// an empty or garbage .pcd). PCL's own test clouds, ASCII, binary and LZF-compressed, read
+// exactly as PCL reads them.
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <string>
+
+#include "fieldrig/traits/cloud_io.h"
+#include "support/temp_dir.h"
+
+namespace fieldrig::traits {
+namespace {
+
+using testing_support::ScopedTempDir;
+
+const std::string kPclData = std::string(FIELDRIG_SHARED_DATA_DIR) + "/pointclouds/pcl/";
+
+std::string writeFile(const ScopedTempDir& dir, const std::string& name, const std::string& bytes) {
+  const std::string path = (dir / name).string();
+  std::ofstream(path, std::ios::binary) << bytes;
+  return path;
+}
+
+// The load fails, its message starts with the file and contains `what`.
+void expectRefused(const std::string& path, const std::string& what) {
+  const auto loaded = loadCloud(path);
+  ASSERT_FALSE(loaded) << path << " loaded " << loaded->size() << " points";
+  EXPECT_EQ(loaded.error().message.rfind(path + ":", 0), 0u) << loaded.error().message;
+  EXPECT_NE(loaded.error().message.find(what), std::string::npos) << loaded.error().message;
+}
+
+std::string binary(std::initializer_list<float> values) {
+  std::string bytes(values.size() * sizeof(float), '\0');
+  std::memcpy(bytes.data(), values.begin(), bytes.size());
+  return bytes;
+}
+
+const std::string kPlyBinaryHead =
+    "ply\nformat binary_little_endian 1.0\nelement vertex COUNT\nproperty float x\n"
+    "property float y\nproperty float z\nend_header\n";
+const std::string kPlyAsciiHead =
+    "ply\nformat ascii 1.0\nelement vertex COUNT\nproperty float x\nproperty float y\n"
+    "property float z\nend_header\n";
+
+std::string withCount(std::string head, const std::string& count) {
+  return head.replace(head.find("COUNT"), 5, count);
+}
+
+TEST(CloudIo, PlyHugeVertexCountsAreRefusedBeforeReserving) {
+  ScopedTempDir dir("cloud_io_ply_huge");
+  const std::string points = binary({1, 2, 3, 4, 5, 6});
+  for (const char* count : {"2147483647", "4294967295", "3"}) {
+    expectRefused(writeFile(dir, "huge.ply", withCount(kPlyBinaryHead, count) + points),
+                  "the header declares " + std::string(count) +
+                      " 'vertex' elements, but the file's 24 bytes after the header hold at most "
+                      "2 (12 bytes each)");
+  }
+  expectRefused(
+      writeFile(dir, "huge_ascii.ply", withCount(kPlyAsciiHead, "4294967295") + "1 2 3\n4 5 6\n"),
+      "hold at most 2 (6 bytes each at the least in ASCII)");
+  std::string with_faces = withCount(kPlyBinaryHead, "2");
+  with_faces.insert(with_faces.find("end_header"),
+                    "element face 1000000000\nproperty list uchar int vertex_indices\n");
+  expectRefused(writeFile(dir, "huge_face.ply", with_faces + points),
+                "declares 1000000000 'face' elements");
+  // A count beyond 64 bits is no count at all.
+  expectRefused(
+      writeFile(dir, "overflow.ply", withCount(kPlyBinaryHead, "99999999999999999999999") + points),
+      "expected 'element NAME COUNT' with a whole COUNT");
+}
+
+TEST(CloudIo, PlyTruncatedGarbageEmptyAndFolder) {
+  ScopedTempDir dir("cloud_io_ply_bad");
+  // Fewer bytes than the declared vertices need, but within the bound: PCL's reader refuses it.
+  const auto truncated = loadCloud(
+      writeFile(dir, "cut.ply", withCount(kPlyAsciiHead, "3") + "1 2 3\n4 5 6\n7.5 8.25\n"));
+  ASSERT_FALSE(truncated);
+  EXPECT_NE(truncated.error().message.find("cut.ply"), std::string::npos);
+  expectRefused(writeFile(dir, "no_end.ply", "ply\nformat ascii 1.0\nelement vertex 1\n"),
+                "no 'end_header' line");
+  expectRefused(writeFile(dir, "garbage.ply", std::string("\x7f\x00\x13garbage\n\xff", 12)),
+                "not a PLY file");
+  expectRefused(writeFile(dir, "empty.ply", ""), "empty file");
+  std::filesystem::create_directory(dir / "folder.ply");
+  expectRefused((dir / "folder.ply").string(), "is a folder, not a cloud file");
+  expectRefused((dir / "absent.ply").string(), "no such file");
+}
+
+TEST(CloudIo, PlyWithinTheFileLoads) {
+  ScopedTempDir dir("cloud_io_ply_good");
+  auto loaded = loadCloud(
+      writeFile(dir, "two.ply", withCount(kPlyBinaryHead, "2") + binary({1, 2, 3, 4, 5, 6})));
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  ASSERT_EQ(loaded->size(), 2u);
+  EXPECT_EQ((*loaded)[1], Eigen::Vector3f(4, 5, 6));
+  // The last ASCII line may end without a line break.
+  auto ascii =
+      loadCloud(writeFile(dir, "two_ascii.ply", withCount(kPlyAsciiHead, "2") + "1 2 3\n4 5 6"));
+  ASSERT_TRUE(ascii) << ascii.error().message;
+  EXPECT_EQ(ascii->size(), 2u);
+}
+
+// PCL's test clouds: ASCII (bun0, sac_plane_test) and LZF-compressed binary (the others), read
+// point for point as PCL reads them.
+TEST(CloudIo, PclTestCloudsReadAsPclReadsThem) {
+  for (const char* name : {"bun0.pcd", "sac_plane_test.pcd", "noisy_slice_displaced.pcd",
+                           "table_scene_mug_stereo_textured.pcd"}) {
+    const std::string path = kPclData + name;
+    pcl::PointCloud<pcl::PointXYZ> reference;
+    ASSERT_EQ(pcl::io::loadPCDFile(path, reference), 0) << path;
+    const auto loaded = loadCloud(path);
+    ASSERT_TRUE(loaded) << loaded.error().message;
+    ASSERT_EQ(loaded->size(), reference.size()) << name;
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < reference.size(); ++i) {
+      const pcl::PointXYZ& r = reference[i];
+      const Eigen::Vector3f& p = (*loaded)[i];
+      for (int k = 0; k < 3; ++k) {
+        const float a = p[k];
+        const float b = k == 0 ? r.x : k == 1 ? r.y : r.z;
+        if (!(a == b || (std::isnan(a) && std::isnan(b))))
+          ++differing;
+      }
+    }
+    EXPECT_EQ(differing, 0u) << name;
+  }
+}
+
+const std::string kPcdHead =
+    "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH W\n"
+    "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS W\nDATA KIND\n";
+
+std::string pcdHead(const std::string& points, const std::string& kind) {
+  std::string head = kPcdHead;
+  for (std::size_t at; (at = head.find(" W\n")) != std::string::npos;)
+    head.replace(at, 3, " " + points + "\n");
+  return head.replace(head.find("KIND"), 4, kind);
+}
+
+TEST(CloudIo, PcdBinaryAndAsciiLoad) {
+  ScopedTempDir dir("cloud_io_pcd_good");
+  auto bin =
+      loadCloud(writeFile(dir, "b.pcd", pcdHead("2", "binary") + binary({1, 2, 3, 4, 5, 6})));
+  ASSERT_TRUE(bin) << bin.error().message;
+  ASSERT_EQ(bin->size(), 2u);
+  EXPECT_EQ((*bin)[1], Eigen::Vector3f(4, 5, 6));
+  auto ascii = loadCloud(writeFile(dir, "a.pcd", pcdHead("2", "ascii") + "1 2 3\nnan 5 6\n"));
+  ASSERT_TRUE(ascii) << ascii.error().message;
+  ASSERT_EQ(ascii->size(), 2u);
+  EXPECT_TRUE(std::isnan((*ascii)[1].x()));
+}
+
+TEST(CloudIo, PcdHugeCountsAreRefusedBeforeReserving) {
+  ScopedTempDir dir("cloud_io_pcd_huge");
+  const std::string points = binary({1, 2, 3, 4, 5, 6});
+  expectRefused(writeFile(dir, "huge.pcd", pcdHead("2147483647", "binary") + points),
+                "the header declares 2147483647 points, but the file's 24 bytes after the header "
+                "hold at most 2 (12 bytes each)");
+  expectRefused(writeFile(dir, "huge_ascii.pcd", pcdHead("4294967295", "ascii") + "1 2 3\n"),
+                "hold at most 1 (6 bytes each at the least in ASCII)");
+  // binary_compressed: the block's own sizes against the header and the file.
+  const auto block = [](std::uint32_t compressed, std::uint32_t uncompressed) {
+    std::string bytes(8, '\0');
+    std::memcpy(bytes.data(), &compressed, 4);
+    std::memcpy(bytes.data() + 4, &uncompressed, 4);
+    return bytes;
+  };
+  expectRefused(writeFile(dir, "huge_lzf.pcd",
+                          pcdHead("2147483647", "binary_compressed") + block(4, 4) + "abcd"),
+                "more than a compressed block (at most 4 GiB) holds");
+  expectRefused(writeFile(dir, "lzf_ratio.pcd",
+                          pcdHead("100000", "binary_compressed") + block(4, 1200000) + "abcd"),
+                "more than the 4 compressed bytes can hold");
+  expectRefused(writeFile(dir, "lzf_claims.pcd",
+                          pcdHead("2", "binary_compressed") + block(4000, 24) + "abcd"),
+                "the compressed block claims 4000 bytes, but the file has 4");
+  expectRefused(
+      writeFile(dir, "lzf_size.pcd", pcdHead("2", "binary_compressed") + block(4, 8) + "abcd"),
+      "the compressed block holds 8 bytes, but the header's 2 points of 12 bytes need 24");
+  // A back reference before the start of the output: damaged, not read out of bounds.
+  expectRefused(writeFile(dir, "lzf_damaged.pcd",
+                          pcdHead("2", "binary_compressed") + block(4, 24) + "\xe0\xff\xff\xff"),
+                "LZF data does not decode");
+}
+
+TEST(CloudIo, PcdTruncatedGarbageEmptyAndFolder) {
+  ScopedTempDir dir("cloud_io_pcd_bad");
+  expectRefused(writeFile(dir, "cut.pcd", pcdHead("3", "ascii") + "1.5 2.5 3.5\n4.5 5.5 6.5\n"),
+                "cut off: 2 of the 3 points");
+  expectRefused(writeFile(dir, "cut_bin.pcd", pcdHead("100", "binary") + "abc"),
+                "hold at most 0 (12 bytes each)");
+  expectRefused(writeFile(dir, "short_line.pcd", pcdHead("2", "ascii") + "1.5 2.5 3.5\n4.5 5.5\n"),
+                "data line 2: 2 values, expected 3");
+  expectRefused(writeFile(dir, "word.pcd", pcdHead("1", "ascii") + "1 two 3\n"),
+                "'two' is not a number");
+  // These segfaulted inside PCL's reader.
+  expectRefused(writeFile(dir, "empty.pcd", ""), "empty file");
+  expectRefused(writeFile(dir, "text.pcd", "hello world\n"), "no 'DATA' line");
+  expectRefused(
+      writeFile(dir, "garbage.pcd", std::string("\x01\x02\x03\n\xff\xfe DATA binary\n", 19)),
+      "no 'DATA' line");
+  expectRefused(writeFile(dir, "no_fields.pcd", "VERSION 0.7\nPOINTS 1\nDATA ascii\n1 2 3\n"),
+                "no FIELDS line");
+  expectRefused(
+      writeFile(dir, "mismatch.pcd",
+                "FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n"),
+      "FIELDS names 3 fields but SIZE, TYPE or COUNT gives another number");
+  expectRefused(
+      writeFile(dir, "no_z.pcd", "FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nDATA ascii\n1 2\n"),
+      "no field 'z'");
+  expectRefused(writeFile(dir, "wh.pcd",
+                          "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 4\n"
+                          "HEIGHT 2\nPOINTS 2\nDATA ascii\n1 2 3\n1 2 3\n"),
+                "WIDTH x HEIGHT = 4 x 2 but POINTS = 2");
+  std::filesystem::create_directory(dir / "folder.pcd");
+  expectRefused((dir / "folder.pcd").string(), "is a folder, not a cloud file");
+}
+
+}  // namespace
+}  // namespace fieldrig::traits
