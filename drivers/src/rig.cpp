@@ -60,7 +60,7 @@ Rig::~Rig() {
   stop();
 }
 
-core::Result<bool> Rig::start(SetSink sink) {
+core::Result<void> Rig::start(SetSink sink) {
   if (running_)
     return core::Error{"rig: already started"};
   sink_ = std::move(sink);
@@ -79,7 +79,7 @@ core::Result<bool> Rig::start(SetSink sink) {
       return core::Error{"rig camera " + std::to_string(i) + ": " + started.error().message};
     }
   }
-  return true;
+  return {};
 }
 
 void Rig::stop() {

@@ -309,7 +309,7 @@ class FakeGvCamera {
 };
 
 // Configures `camera` for the fake, retrying while it starts up (bounded).
-core::Result<bool> configureWhenUp(Camera& camera, const CameraConfig& config, FakeGvCamera& fake) {
+core::Result<void> configureWhenUp(Camera& camera, const CameraConfig& config, FakeGvCamera& fake) {
   const auto deadline = std::chrono::steady_clock::now() + 10s;
   while (true) {
     auto configured = camera.configure(config);

@@ -63,7 +63,7 @@ class Rig {
   Rig(const Rig&) = delete;
   Rig& operator=(const Rig&) = delete;
 
-  core::Result<bool> start(SetSink sink);
+  core::Result<void> start(SetSink sink);
   // Stops the cameras, emits what is pending (incomplete), joins the rig thread.
   void stop();
   // Triggers every camera for `event.trigger_id`; the event travels with the set (its sent_time
