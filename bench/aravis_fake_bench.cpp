@@ -60,14 +60,17 @@ int run(int argc, char** argv) {
       std::this_thread::sleep_for(100ms);
       configured = camera.configure(config);
     }
-    fieldrig::core::FramePool pool(16, std::size_t{width} * height);
+    const auto pool = fieldrig::core::FramePool::create(16, std::size_t{width} * height);
     std::mutex mutex;
     std::condition_variable changed;
     std::size_t frames = 0;  // guarded by mutex
     if (!configured.ok()) {
       std::fprintf(stderr, "%s\n", configured.error().message.c_str());
       rc = 1;
-    } else if (auto started = camera.start(pool,
+    } else if (!pool) {
+      std::fprintf(stderr, "%s\n", pool.error().message.c_str());
+      rc = 1;
+    } else if (auto started = camera.start(**pool,
                                            [&](fieldrig::core::Frame&&) {
                                              std::lock_guard lock(mutex);
                                              ++frames;

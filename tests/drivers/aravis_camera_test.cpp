@@ -112,9 +112,9 @@ TEST(AravisCameraTest, InProcessFakeGivesOneFramePerTrigger) {
   auto camera = createAravis();
   ASSERT_TRUE(camera);
   ASSERT_TRUE(camera->configure(cameraConfig("Fake_1")).ok());
-  core::FramePool pool(8, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(8, std::size_t{kWidth} * kHeight).value();
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sink()).ok());
+  ASSERT_TRUE(camera->start(*pool, collector.sink()).ok());
   constexpr int kTriggers = 10;
   const auto slowest = triggerInStep(*camera, collector, kTriggers, 1s);
   camera->stop();
@@ -190,8 +190,8 @@ TEST(AravisCameraTest, UnknownIdIsNamed) {
   ASSERT_FALSE(configured.ok());
   EXPECT_NE(configured.error().message.find("'Fake_9'"), std::string::npos)
       << configured.error().message;
-  core::FramePool pool(2, std::size_t{kWidth} * kHeight);
-  EXPECT_FALSE(camera->start(pool, [](core::Frame&&) {}).ok());
+  const auto pool = core::FramePool::create(2, std::size_t{kWidth} * kHeight).value();
+  EXPECT_FALSE(camera->start(*pool, [](core::Frame&&) {}).ok());
 }
 
 TEST(AravisCameraTest, UnsupportedPixelFormatNamesTheFeature) {
@@ -218,8 +218,8 @@ TEST(AravisCameraTest, ExternalTriggerRefusesSoftwareTriggers) {
       << bad_line.error().message;
   config.options.erase("trigger_line");
   ASSERT_TRUE(camera->configure(config).ok());
-  core::FramePool pool(4, std::size_t{kWidth} * kHeight);
-  ASSERT_TRUE(camera->start(pool, [](core::Frame&&) {}).ok());
+  const auto pool = core::FramePool::create(4, std::size_t{kWidth} * kHeight).value();
+  ASSERT_TRUE(camera->start(*pool, [](core::Frame&&) {}).ok());
   EXPECT_FALSE(camera->trigger(1));
   camera->stop();
 }
@@ -333,9 +333,9 @@ TEST_F(AravisGigETest, TwoHundredTriggeredFramesNoneLost) {
   ASSERT_TRUE(camera);
   const auto configured = configureWhenUp(*camera, cameraConfig(fake.address()), fake);
   ASSERT_TRUE(configured.ok()) << configured.error().message;
-  core::FramePool pool(16, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(16, std::size_t{kWidth} * kHeight).value();
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sink()).ok());
+  ASSERT_TRUE(camera->start(*pool, collector.sink()).ok());
   constexpr int kTriggers = 200;
   const auto slowest = triggerInStep(*camera, collector, kTriggers, 500ms);
   camera->stop();
@@ -365,9 +365,9 @@ TEST_F(AravisGigETest, PacketLossIsCountedNeverBlocks) {
   config.options["packet_resend"] = "never";  // each loss must show, not be repaired
   const auto configured = configureWhenUp(*camera, config, fake);
   ASSERT_TRUE(configured.ok()) << configured.error().message;
-  core::FramePool pool(16, std::size_t{64} * 48);
+  const auto pool = core::FramePool::create(16, std::size_t{64} * 48).value();
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sink()).ok());
+  ASSERT_TRUE(camera->start(*pool, collector.sink()).ok());
   constexpr int kTriggers = 200;
   const auto started = std::chrono::steady_clock::now();
   triggerInStep(*camera, collector, kTriggers, 150ms);

@@ -56,7 +56,8 @@ class Rig {
  public:
   using SetSink = std::function<void(core::FrameSet&& set)>;
 
-  // Creates and configures the cameras; errors name the camera and the problem.
+  // Allocates the frame pool, creates and configures the cameras; errors name the camera (or the
+  // pool) and the problem.
   static core::Result<std::unique_ptr<Rig>> create(const RigOptions& options,
                                                    const CameraRegistry& registry);
   ~Rig();
@@ -84,7 +85,8 @@ class Rig {
     core::SteadyTime issued{};
   };
 
-  Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras);
+  Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras,
+      std::unique_ptr<core::FramePool> pool);
   void run();
   void drainTriggers();
   void drainFrames();
