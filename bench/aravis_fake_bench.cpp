@@ -42,15 +42,18 @@ int run(int argc, char** argv) {
     config.width = width;
     config.height = height;
     const auto configured = configureWhenUp(camera, config, fake);
-    fieldrig::core::FramePool pool(16, std::size_t{width} * height);
+    const auto pool = fieldrig::core::FramePool::create(16, std::size_t{width} * height);
     // Only the count matters here: each frame's metadata is kept, its buffer goes back at once.
     Collector<fieldrig::core::FrameMetadata> frames;
     if (!configured.ok()) {
       std::fprintf(stderr, "%s\n", configured.error().message.c_str());
       rc = 1;
+    } else if (!pool) {
+      std::fprintf(stderr, "%s\n", pool.error().message.c_str());
+      rc = 1;
     } else if (auto started = camera.start(
-                   pool, frames.sinkKeeping<fieldrig::core::Frame>(
-                             [](const fieldrig::core::Frame& frame) { return frame.metadata; }));
+                   **pool, frames.sinkKeeping<fieldrig::core::Frame>(
+                               [](const fieldrig::core::Frame& frame) { return frame.metadata; }));
                !started.ok()) {
       std::fprintf(stderr, "%s\n", started.error().message.c_str());
       rc = 1;

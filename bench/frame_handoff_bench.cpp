@@ -54,7 +54,12 @@ class MutexQueue {
 };
 
 void BM_HandOff_LockFreeSpsc(benchmark::State& state) {
-  FramePool pool(6 * (kQueueCapacity + 4), 64);
+  auto created = FramePool::create(6 * (kQueueCapacity + 4), 64);
+  if (!created) {
+    state.SkipWithError(created.error().message.c_str());
+    return;
+  }
+  FramePool& pool = **created;
   for (auto _ : state) {
     SpscQueue<FrameSet> queue(kQueueCapacity);
     std::thread consumer([&] {
@@ -77,7 +82,12 @@ void BM_HandOff_LockFreeSpsc(benchmark::State& state) {
 }
 
 void BM_HandOff_MutexConditionVariable(benchmark::State& state) {
-  FramePool pool(6 * (kQueueCapacity + 4), 64);
+  auto created = FramePool::create(6 * (kQueueCapacity + 4), 64);
+  if (!created) {
+    state.SkipWithError(created.error().message.c_str());
+    return;
+  }
+  FramePool& pool = **created;
   for (auto _ : state) {
     MutexQueue queue(kQueueCapacity);
     std::thread consumer([&] {

@@ -1,23 +1,44 @@
 #include "fieldrig/core/frame_pool.h"
 
-#include <stdexcept>
+#include <fmt/format.h>
+
+#include <limits>
+#include <new>
 #include <utility>
 
 namespace fieldrig::core {
 
+Result<std::unique_ptr<FramePool>> FramePool::create(std::size_t buffer_count,
+                                                     std::size_t buffer_bytes) {
+  if (buffer_count == 0)
+    return Error{"frame pool: the buffer count must be positive"};
+  if (buffer_bytes == 0)
+    return Error{"frame pool: the buffer size must be positive"};
+  if (buffer_count > kMaxBuffers) {
+    return Error{
+        fmt::format("frame pool: {} buffers requested, at most {} (Boost.Lockfree's limit)",
+                    buffer_count, kMaxBuffers)};
+  }
+  if (buffer_bytes > std::numeric_limits<std::size_t>::max() / buffer_count) {
+    return Error{fmt::format("frame pool: {} buffers of {} bytes overflow the addressable size",
+                             buffer_count, buffer_bytes)};
+  }
+  // Allocation is the one failure left, and a pool is sized from configuration: report it.
+  try {
+    return std::unique_ptr<FramePool>(new FramePool(buffer_count, buffer_bytes));
+  } catch (const std::bad_alloc&) {
+    return Error{fmt::format("frame pool: cannot allocate {} buffers of {} bytes ({} bytes in all)",
+                             buffer_count, buffer_bytes, buffer_count * buffer_bytes)};
+  }
+}
+
 FramePool::FramePool(std::size_t buffer_count, std::size_t buffer_bytes)
     : buffer_count_(buffer_count),
       buffer_bytes_(buffer_bytes),
-      // boost's fixed-size queue indexes its nodes with 16 bits, hence the limit below.
+      memory_(std::make_unique<std::uint8_t[]>(buffer_count * buffer_bytes)),
+      references_(std::make_unique<std::atomic<int>[]>(buffer_count)),
       free_(buffer_count),
       available_(buffer_count) {
-  if (buffer_count == 0 || buffer_bytes == 0) {
-    throw std::invalid_argument("frame pool: buffer count and size must be positive");
-  }
-  if (buffer_count > 65534)
-    throw std::invalid_argument("frame pool: at most 65534 buffers");
-  memory_ = std::make_unique<std::uint8_t[]>(buffer_count * buffer_bytes);
-  references_ = std::make_unique<std::atomic<int>[]>(buffer_count);
   for (std::size_t i = 0; i < buffer_count; ++i) {
     references_[i].store(0, std::memory_order_relaxed);
     free_.bounded_push(static_cast<std::uint32_t>(i));

@@ -60,7 +60,7 @@ Acquisition::~Acquisition() {
     finish(std::chrono::milliseconds{0});
 }
 
-core::Result<bool> Acquisition::start(ProcessSet process) {
+core::Result<void> Acquisition::start(ProcessSet process) {
   process_ = std::move(process);
   running_ = true;
   recorder_ = std::thread([this] { recordLoop(); });
@@ -88,7 +88,7 @@ core::Result<bool> Acquisition::start(ProcessSet process) {
     finish(std::chrono::milliseconds{0});
     return started.error();
   }
-  return true;
+  return {};
 }
 
 bool Acquisition::trigger(core::TriggerEvent event) {

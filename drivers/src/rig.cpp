@@ -36,21 +36,32 @@ core::Result<std::unique_ptr<Rig>> Rig::create(const RigOptions& options,
     }
     cameras.push_back(std::move(*camera));
   }
-  return std::unique_ptr<Rig>(new Rig(options, std::move(cameras)));
+  // The pool comes after the cameras, whose own errors explain a bad frame size better.
+  // pool_sets is unbounded in the configuration: refused before the product can wrap.
+  if (options.pool_sets > core::FramePool::kMaxBuffers / options.cameras.size()) {
+    return core::Error{"rig: " + std::to_string(options.pool_sets) + " pool sets of " +
+                       std::to_string(options.cameras.size()) + " cameras exceed the " +
+                       std::to_string(core::FramePool::kMaxBuffers) + " buffers a pool can hold"};
+  }
+  std::size_t largest = 0;
+  for (const CameraConfig& c : options.cameras) {
+    largest = std::max(largest, std::size_t{c.width} * c.height);
+  }
+  auto pool = core::FramePool::create(options.pool_sets * options.cameras.size(), largest);
+  if (!pool)
+    return core::Error{"rig: " + pool.error().message};
+  return std::unique_ptr<Rig>(new Rig(options, std::move(cameras), std::move(*pool)));
 }
 
-Rig::Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras)
+Rig::Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras,
+         std::unique_ptr<core::FramePool> pool)
     : options_(std::move(options)),
       cameras_(std::move(cameras)),
+      pool_(std::move(pool)),
       grouper_(grouperOptions(options_), [this](core::FrameSet&& set) {
         if (sink_)
           sink_(std::move(set));
       }) {
-  std::size_t largest = 0;
-  for (const CameraConfig& c : options_.cameras) {
-    largest = std::max(largest, std::size_t{c.width} * c.height);
-  }
-  pool_ = std::make_unique<core::FramePool>(options_.pool_sets * cameras_.size(), largest);
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
     frame_queues_.push_back(std::make_unique<core::SpscQueue<core::Frame>>(kFrameQueueCapacity));
   }
@@ -60,7 +71,7 @@ Rig::~Rig() {
   stop();
 }
 
-core::Result<bool> Rig::start(SetSink sink) {
+core::Result<void> Rig::start(SetSink sink) {
   if (running_)
     return core::Error{"rig: already started"};
   sink_ = std::move(sink);
@@ -79,7 +90,7 @@ core::Result<bool> Rig::start(SetSink sink) {
       return core::Error{"rig camera " + std::to_string(i) + ": " + started.error().message};
     }
   }
-  return true;
+  return {};
 }
 
 void Rig::stop() {

@@ -358,7 +358,7 @@ core::Result<LocationMap> LocationMap::parse(std::string_view text, std::string_
   return map;
 }
 
-core::Result<bool> LocationMap::add(ImagingLocation location) {
+core::Result<void> LocationMap::add(ImagingLocation location) {
   const std::string where = "location '" + location.id + "': ";
   if (auto bad = checkLocation(location))
     return core::Error{where + *bad};
@@ -371,7 +371,7 @@ core::Result<bool> LocationMap::add(ImagingLocation location) {
   }
   index_by_id_.emplace(location.id, locations_.size());
   locations_.push_back(std::move(location));
-  return true;
+  return {};
 }
 
 const ImagingLocation* LocationMap::find(std::string_view id) const {
@@ -415,11 +415,11 @@ std::string LocationMap::toCsv() const {
   return out;
 }
 
-core::Result<bool> LocationMap::save(const std::filesystem::path& path) const {
+core::Result<void> LocationMap::save(const std::filesystem::path& path) const {
   // Replaced whole or not at all: a crash never leaves half a map.
   if (std::string error = core::replaceFileAtomically(path, toCsv()); !error.empty())
     return core::Error{error};
-  return true;
+  return {};
 }
 
 }  // namespace fieldrig::gps

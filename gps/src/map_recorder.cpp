@@ -154,7 +154,7 @@ core::Result<RecordedLocation> MapRecorder::mark(core::SteadyTime now) {
   location.metadata = {core::formatIso8601(fix.time, 3),
                        fix.speed_mps ? fmt::format("{:.3f}", *fix.speed_mps) : std::string(),
                        fix.quality ? std::to_string(static_cast<int>(*fix.quality)) : ""};
-  if (core::Result<bool> added = map_.add(location); !added)
+  if (core::Result<void> added = map_.add(location); !added)
     return added.error();
   ++next_number_;
   return recorded;

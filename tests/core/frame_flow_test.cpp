@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <limits>
 #include <new>
 #include <thread>
 #include <vector>
@@ -32,37 +33,79 @@ namespace fieldrig::core {
 namespace {
 
 TEST(FramePoolTest, HandsOutEveryBufferOnceThenRefusesWithoutBlocking) {
-  FramePool pool(3, 16);
+  const auto pool = FramePool::create(3, 16).value();
   std::vector<FrameBuffer> held;
   for (int i = 0; i < 3; ++i) {
-    held.push_back(pool.acquire());
+    held.push_back(pool->acquire());
     ASSERT_TRUE(held.back());
     EXPECT_EQ(held.back().size(), 16u);
   }
-  EXPECT_EQ(pool.available(), 0u);
-  EXPECT_FALSE(pool.acquire());  // exhausted: empty, at once
+  EXPECT_EQ(pool->available(), 0u);
+  EXPECT_FALSE(pool->acquire());  // exhausted: empty, at once
   // Distinct memory for each buffer.
   EXPECT_NE(held[0].bytes().data(), held[1].bytes().data());
   EXPECT_NE(held[1].bytes().data(), held[2].bytes().data());
   held.pop_back();
-  EXPECT_EQ(pool.available(), 1u);
-  EXPECT_TRUE(pool.acquire());
+  EXPECT_EQ(pool->available(), 1u);
+  EXPECT_TRUE(pool->acquire());
 }
 
 TEST(FramePoolTest, BufferReturnsWhenTheLastCopyIsReleased) {
-  FramePool pool(1, 8);
-  FrameBuffer recorder = pool.acquire();
+  const auto pool = FramePool::create(1, 8).value();
+  FrameBuffer recorder = pool->acquire();
   recorder.bytes()[0] = 42;
   FrameBuffer pipeline = recorder;  // both consumers hold the frame
   EXPECT_EQ(recorder.useCount(), 2);
   EXPECT_EQ(pipeline.bytes()[0], 42);
   recorder.reset();
-  EXPECT_EQ(pool.available(), 0u);  // still held by the pipeline
+  EXPECT_EQ(pool->available(), 0u);  // still held by the pipeline
   FrameBuffer moved = std::move(pipeline);
   EXPECT_FALSE(pipeline);  // NOLINT(bugprone-use-after-move): moved-from is empty by contract
   EXPECT_EQ(moved.useCount(), 1);
   moved = FrameBuffer{};
-  EXPECT_EQ(pool.available(), 1u);
+  EXPECT_EQ(pool->available(), 1u);
+}
+
+TEST(FramePoolTest, RefusesNoBuffersAndEmptyBuffers) {
+  const auto no_buffers = FramePool::create(0, 16);
+  ASSERT_FALSE(no_buffers);
+  EXPECT_EQ(no_buffers.error().message, "frame pool: the buffer count must be positive");
+  const auto empty_buffers = FramePool::create(4, 0);
+  ASSERT_FALSE(empty_buffers);
+  EXPECT_EQ(empty_buffers.error().message, "frame pool: the buffer size must be positive");
+}
+
+TEST(FramePoolTest, HoldsUpToTheFreeListLimitAndRefusesOneMore) {
+  const auto largest = FramePool::create(FramePool::kMaxBuffers, 1);
+  ASSERT_TRUE(largest) << largest.error().message;
+  EXPECT_EQ((*largest)->capacity(), FramePool::kMaxBuffers);
+  std::vector<FrameBuffer> held;
+  while (FrameBuffer buffer = (*largest)->acquire())
+    held.push_back(std::move(buffer));
+  EXPECT_EQ(held.size(), FramePool::kMaxBuffers);  // every index made it into the free list
+
+  const auto too_many = FramePool::create(FramePool::kMaxBuffers + 1, 1);
+  ASSERT_FALSE(too_many);
+  EXPECT_EQ(too_many.error().message,
+            "frame pool: 65535 buffers requested, at most 65534 (Boost.Lockfree's limit)");
+}
+
+TEST(FramePoolTest, RefusesATotalSizeThatOverflows) {
+  const std::size_t half = std::numeric_limits<std::size_t>::max() / 2 + 1;
+  const auto overflowing = FramePool::create(2, half);
+  ASSERT_FALSE(overflowing);
+  EXPECT_EQ(overflowing.error().message, "frame pool: 2 buffers of " + std::to_string(half) +
+                                             " bytes overflow the addressable size");
+}
+
+TEST(FramePoolTest, ReportsAnAllocationThatFailsWithTheRequestedSize) {
+  // 1 PiB in all: beyond any machine's memory and a 47-bit user address space alike.
+  const std::size_t buffer_bytes = std::size_t{1} << 48;
+  const auto unallocatable = FramePool::create(4, buffer_bytes);
+  ASSERT_FALSE(unallocatable);
+  EXPECT_EQ(unallocatable.error().message,
+            "frame pool: cannot allocate 4 buffers of 281474976710656 bytes "
+            "(1125899906842624 bytes in all)");
 }
 
 TEST(FrameSetTest, CompleteOnlyWhenEveryCameraDelivered) {
@@ -75,7 +118,7 @@ TEST(FrameSetTest, CompleteOnlyWhenEveryCameraDelivered) {
 }
 
 TEST(FrameFlowTest, SteadyStateAllocatesNothing) {
-  FramePool pool(24, 1024);
+  const auto pool = FramePool::create(24, 1024).value();
   SpscQueue<FrameSet> queue(4);
   FrameSet set;
   set.camera_count = 6;
@@ -83,7 +126,7 @@ TEST(FrameFlowTest, SteadyStateAllocatesNothing) {
   for (int round = 0; round < 1000; ++round) {
     set.trigger_id = static_cast<std::uint64_t>(round);
     for (std::uint32_t c = 0; c < 6; ++c) {
-      set.frames[c].buffer = pool.acquire();
+      set.frames[c].buffer = pool->acquire();
       set.frames[c].metadata.camera = c;
     }
     ASSERT_TRUE(queue.tryPush(set));
@@ -96,7 +139,7 @@ TEST(FrameFlowTest, SteadyStateAllocatesNothing) {
 
 TEST(FrameFlowTest, ProducerAndConsumerThreadsShareAndRecycleBuffers) {
   constexpr int kSets = 20000;
-  FramePool pool(6 * 8, 64);
+  const auto pool = FramePool::create(6 * 8, 64).value();
   SpscQueue<FrameSet> queue(4);
   std::atomic<int> dropped{0};
   std::thread producer([&] {
@@ -105,7 +148,7 @@ TEST(FrameFlowTest, ProducerAndConsumerThreadsShareAndRecycleBuffers) {
       set.trigger_id = static_cast<std::uint64_t>(i);
       set.camera_count = 6;
       for (std::uint32_t c = 0; c < 6; ++c) {
-        set.frames[c].buffer = pool.acquire();
+        set.frames[c].buffer = pool->acquire();
         if (!set.frames[c].buffer) {
           set.frames[c].metadata.status = FrameStatus::kDropped;
           continue;
@@ -135,7 +178,7 @@ TEST(FrameFlowTest, ProducerAndConsumerThreadsShareAndRecycleBuffers) {
     ++received;
   }
   producer.join();
-  EXPECT_EQ(pool.available(), pool.capacity());  // every buffer came back
+  EXPECT_EQ(pool->available(), pool->capacity());  // every buffer came back
   // 48 buffers for at most 4 queued + 1 in hand + 1 being filled sets of 6: never exhausted.
   EXPECT_EQ(dropped.load(), 0);
 }

@@ -70,9 +70,9 @@ TEST(AravisCameraTest, InProcessFakeGivesOneFramePerTrigger) {
   auto camera = createAravis();
   ASSERT_TRUE(camera);
   ASSERT_TRUE(camera->configure(cameraConfig("Fake_1")).ok());
-  core::FramePool pool(8, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(8, std::size_t{kWidth} * kHeight).value();
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
+  ASSERT_TRUE(camera->start(*pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
   constexpr int kTriggers = 10;
   const auto triggered = triggerInStep(*camera, collector, kTriggers, 1s);
   camera->stop();
@@ -141,8 +141,8 @@ TEST(AravisCameraTest, UnknownIdIsNamed) {
   ASSERT_FALSE(configured.ok());
   EXPECT_NE(configured.error().message.find("'Fake_9'"), std::string::npos)
       << configured.error().message;
-  core::FramePool pool(2, std::size_t{kWidth} * kHeight);
-  EXPECT_FALSE(camera->start(pool, [](core::Frame&&) {}).ok());
+  const auto pool = core::FramePool::create(2, std::size_t{kWidth} * kHeight).value();
+  EXPECT_FALSE(camera->start(*pool, [](core::Frame&&) {}).ok());
 }
 
 TEST(AravisCameraTest, UnsupportedPixelFormatNamesTheFeature) {
@@ -169,8 +169,8 @@ TEST(AravisCameraTest, ExternalTriggerRefusesSoftwareTriggers) {
       << bad_line.error().message;
   config.options.erase("trigger_line");
   ASSERT_TRUE(camera->configure(config).ok());
-  core::FramePool pool(4, std::size_t{kWidth} * kHeight);
-  ASSERT_TRUE(camera->start(pool, [](core::Frame&&) {}).ok());
+  const auto pool = core::FramePool::create(4, std::size_t{kWidth} * kHeight).value();
+  ASSERT_TRUE(camera->start(*pool, [](core::Frame&&) {}).ok());
   EXPECT_FALSE(camera->trigger(1));
   camera->stop();
 }
@@ -213,9 +213,9 @@ TEST_F(AravisGigETest, TwoHundredTriggeredFramesNoneLost) {
   ASSERT_TRUE(camera);
   const auto configured = configureWhenUp(*camera, cameraConfig(fake.address()), fake);
   ASSERT_TRUE(configured.ok()) << configured.error().message;
-  core::FramePool pool(16, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(16, std::size_t{kWidth} * kHeight).value();
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
+  ASSERT_TRUE(camera->start(*pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
   constexpr int kTriggers = 200;
   const auto triggered = triggerInStep(*camera, collector, kTriggers, 500ms);
   camera->stop();
@@ -246,9 +246,9 @@ TEST_F(AravisGigETest, PacketLossIsCountedNeverBlocks) {
   config.options["packet_resend"] = "never";  // each loss must show, not be repaired
   const auto configured = configureWhenUp(*camera, config, fake);
   ASSERT_TRUE(configured.ok()) << configured.error().message;
-  core::FramePool pool(16, std::size_t{64} * 48);
+  const auto pool = core::FramePool::create(16, std::size_t{64} * 48).value();
   Collector collector;
-  ASSERT_TRUE(camera->start(pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
+  ASSERT_TRUE(camera->start(*pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
   constexpr int kTriggers = 200;
   const auto started = std::chrono::steady_clock::now();
   const auto triggered = triggerInStep(*camera, collector, kTriggers, 150ms);

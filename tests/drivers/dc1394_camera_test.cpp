@@ -65,8 +65,8 @@ TEST(Dc1394Camera, WithoutABusConfigureSaysSoClearly) {
   EXPECT_TRUE(isNoBus(configured.error().message)) << configured.error().message;
 
   // The camera stays unusable, and says so, without crashing.
-  core::FramePool pool(2, 1624 * 1224);
-  const auto started = camera.start(pool, [](core::Frame&&) {});
+  const auto pool = core::FramePool::create(2, 1624 * 1224).value();
+  const auto started = camera.start(*pool, [](core::Frame&&) {});
   ASSERT_FALSE(started.ok());
   EXPECT_NE(started.error().message.find("start before a successful configure"), std::string::npos);
   EXPECT_FALSE(camera.trigger(1));

@@ -53,7 +53,8 @@ class Dc1394FakeBus : public ::testing::Test {
     return c;
   }
 
-  core::FramePool pool_{8, std::size_t{kWidth} * kHeight};
+  std::unique_ptr<core::FramePool> pool_ =
+      core::FramePool::create(8, std::size_t{kWidth} * kHeight).value();
   // Frames collected on the driver thread; the test thread waits (3 s at most) for a count.
   testing_support::Collector<core::Frame> frames_{3s};
 };
@@ -124,7 +125,7 @@ TEST_F(Dc1394FakeBus, AWrongColourFilterOrAnOversizedRoiIsRefused) {
 TEST_F(Dc1394FakeBus, TriggersBecomeFramesWithTheirIdsInOrder) {
   Dc1394Camera camera;
   ASSERT_TRUE(camera.configure(config()).ok());
-  ASSERT_TRUE(camera.start(pool_, frames_.sink()).ok());
+  ASSERT_TRUE(camera.start(*pool_, frames_.sink()).ok());
   for (std::uint64_t id = 100; id < 105; ++id) {
     ASSERT_TRUE(camera.trigger(id));
     std::this_thread::sleep_for(2ms);
@@ -164,7 +165,7 @@ TEST_F(Dc1394FakeBus, AMissedTriggerIsCountedAndLaterFramesKeepTheirIds) {
   c.options["rate_hz"] = "5";  // a frame more than ~100 ms + transfer late is given up on
   Dc1394Camera camera;
   ASSERT_TRUE(camera.configure(c).ok());
-  ASSERT_TRUE(camera.start(pool_, frames_.sink()).ok());
+  ASSERT_TRUE(camera.start(*pool_, frames_.sink()).ok());
   {
     std::lock_guard lock(fakeDc1394Bus().mutex);
     fakeDc1394Bus().triggers_to_ignore = 1;
@@ -183,10 +184,10 @@ TEST_F(Dc1394FakeBus, AMissedTriggerIsCountedAndLaterFramesKeepTheirIds) {
 }
 
 TEST_F(Dc1394FakeBus, UnexpectedCorruptAndPoolExhaustedFramesAreMarkedAndCounted) {
-  core::FramePool one_buffer(1, std::size_t{kWidth} * kHeight);
+  const auto one_buffer = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
   Dc1394Camera camera;
   ASSERT_TRUE(camera.configure(config()).ok());
-  ASSERT_TRUE(camera.start(one_buffer, frames_.sink()).ok());
+  ASSERT_TRUE(camera.start(*one_buffer, frames_.sink()).ok());
   testing::fakeDc1394SpuriousFrame();  // no trigger: not delivered
   std::this_thread::sleep_for(100ms);
   EXPECT_EQ(camera.stats().unexpected, 1u);
@@ -213,7 +214,7 @@ TEST_F(Dc1394FakeBus, ExternalTriggerAnnouncesIdsForThePulses) {
   c.trigger = TriggerSource::kExternal;
   Dc1394Camera camera;
   ASSERT_TRUE(camera.configure(c).ok());
-  ASSERT_TRUE(camera.start(pool_, frames_.sink()).ok());
+  ASSERT_TRUE(camera.start(*pool_, frames_.sink()).ok());
   ASSERT_TRUE(camera.trigger(7));
   std::this_thread::sleep_for(20ms);
   testing::fakeDc1394Pulse();
@@ -231,7 +232,7 @@ TEST_F(Dc1394FakeBus, BroadcastSenderTriggersTheBusAndReceiversOnlyListen) {
   {
     Dc1394Camera sender;
     ASSERT_TRUE(sender.configure(c).ok());
-    ASSERT_TRUE(sender.start(pool_, frames_.sink()).ok());
+    ASSERT_TRUE(sender.start(*pool_, frames_.sink()).ok());
     ASSERT_TRUE(sender.trigger(1));
     ASSERT_TRUE(frames_.waitFor(1));
   }  // destroyed while running: the destructor stops and releases
@@ -242,7 +243,7 @@ TEST_F(Dc1394FakeBus, BroadcastSenderTriggersTheBusAndReceiversOnlyListen) {
   c.options["trigger_broadcast"] = "receive";
   Dc1394Camera receiver;
   ASSERT_TRUE(receiver.configure(c).ok());
-  ASSERT_TRUE(receiver.start(pool_, frames_.sink()).ok());
+  ASSERT_TRUE(receiver.start(*pool_, frames_.sink()).ok());
   ASSERT_TRUE(receiver.trigger(2));
   std::this_thread::sleep_for(50ms);
   receiver.stop();
@@ -270,7 +271,7 @@ TEST_F(Dc1394FakeBus, IsoResourcesAreReleasedWhenCaptureSetupFails) {
   }
   Dc1394Camera camera;
   ASSERT_TRUE(camera.configure(config()).ok());
-  const auto started = camera.start(pool_, frames_.sink());
+  const auto started = camera.start(*pool_, frames_.sink());
   ASSERT_FALSE(started.ok());
   EXPECT_NE(started.error().message.find("capture setup"), std::string::npos);
   EXPECT_FALSE(camera.trigger(1));
@@ -286,7 +287,7 @@ TEST_F(Dc1394FakeBus, IsoResourcesAreReleasedWhenTransmissionFails) {
   }
   Dc1394Camera camera;
   ASSERT_TRUE(camera.configure(config()).ok());
-  ASSERT_FALSE(camera.start(pool_, frames_.sink()).ok());
+  ASSERT_FALSE(camera.start(*pool_, frames_.sink()).ok());
   std::lock_guard lock(fakeDc1394Bus().mutex);
   EXPECT_EQ(fakeDc1394Bus().capture_stops, 1);
   EXPECT_EQ(fakeDc1394Bus().iso_release_alls, 1);
@@ -297,7 +298,7 @@ TEST_F(Dc1394FakeBus, RestartAfterStopSetsUpAgain) {
   Dc1394Camera camera;
   ASSERT_TRUE(camera.configure(config()).ok());
   for (int round = 0; round < 3; ++round) {
-    ASSERT_TRUE(camera.start(pool_, frames_.sink()).ok());
+    ASSERT_TRUE(camera.start(*pool_, frames_.sink()).ok());
     ASSERT_TRUE(camera.trigger(static_cast<std::uint64_t>(round)));
     ASSERT_TRUE(frames_.waitFor(static_cast<std::size_t>(round) + 1));
     camera.stop();

@@ -42,7 +42,7 @@ class FrameGrouperTest : public ::testing::Test {
   core::Frame frame(std::uint32_t camera, std::uint64_t trigger_id,
                     std::int64_t device_timestamp_ns = 0) {
     core::Frame f;
-    f.buffer = pool_.acquire();
+    f.buffer = pool_->acquire();
     f.buffer.bytes()[0] = pixelFor(camera, trigger_id);
     f.metadata.camera = camera;
     f.metadata.trigger_id = trigger_id;
@@ -54,7 +54,7 @@ class FrameGrouperTest : public ::testing::Test {
     return static_cast<std::uint8_t>(trigger_id * kCameras + camera);
   }
 
-  core::FramePool pool_{256, 16};
+  std::unique_ptr<core::FramePool> pool_ = core::FramePool::create(256, 16).value();
   std::vector<core::FrameSet> sets_;
 };
 
@@ -157,9 +157,9 @@ TEST_F(FrameGrouperTest, ALateFrameAfterItsSetLeftIsReleasedAndCounted) {
     grouper.addFrame(frame(c, 1));
   grouper.advance(kStart + 500ms);
   ASSERT_EQ(sets_.size(), 1u);
-  const std::size_t available = pool_.available();
+  const std::size_t available = pool_->available();
   EXPECT_EQ(grouper.addFrame(frame(kCameras - 1, 1)), FrameOutcome::kLate);
-  EXPECT_EQ(pool_.available(), available);  // its buffer went straight back
+  EXPECT_EQ(pool_->available(), available);  // its buffer went straight back
   EXPECT_EQ(sets_.size(), 1u);
   EXPECT_EQ(sets_[0].frames[kCameras - 1].metadata.status, core::FrameStatus::kMissing);
   // Trigger 2's set is not disturbed: it still waits for all six.
@@ -178,9 +178,9 @@ TEST_F(FrameGrouperTest, ADuplicateIsRejectedAndTheFirstFrameKept) {
   ASSERT_EQ(grouper.addFrame(frame(2, 1)), FrameOutcome::kGrouped);
   core::Frame second = frame(2, 1);
   second.buffer.bytes()[0] = 0xEE;
-  const std::size_t available = pool_.available();
+  const std::size_t available = pool_->available();
   EXPECT_EQ(grouper.addFrame(std::move(second)), FrameOutcome::kDuplicate);
-  EXPECT_EQ(pool_.available(), available + 1);
+  EXPECT_EQ(pool_->available(), available + 1);
   for (std::uint32_t c = 0; c < kCameras; ++c) {
     if (c != 2)
       grouper.addFrame(frame(c, 1));
@@ -202,7 +202,7 @@ TEST_F(FrameGrouperTest, FramesOfUnknownCamerasAndTriggersAreRejected) {
   EXPECT_EQ(grouper.addFrame(frame(0, 2)), FrameOutcome::kUnknownTrigger);  // an id skipped
   EXPECT_EQ(grouper.stats().frames_unknown_camera, 1u);
   EXPECT_EQ(grouper.stats().frames_unknown_trigger, 2u);
-  EXPECT_EQ(pool_.available(), pool_.capacity());
+  EXPECT_EQ(pool_->available(), pool_->capacity());
   grouper.flush();
   ASSERT_EQ(sets_.size(), 2u);
   for (const core::FrameSet& set : sets_) {  // nothing of the rejected frames got in
@@ -302,7 +302,7 @@ TEST_F(FrameGrouperTest, BuffersReturnWhenTheSinkCopiesTheSet) {
       grouper.addFrame(frame(c, id));
   }
   EXPECT_EQ(complete, 3u);
-  EXPECT_EQ(pool_.available(), pool_.capacity());
+  EXPECT_EQ(pool_->available(), pool_->capacity());
 }
 
 }  // namespace

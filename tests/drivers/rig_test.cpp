@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -206,6 +207,20 @@ TEST_F(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
   ASSERT_FALSE(rig.ok());
   EXPECT_NE(rig.error().message.find("unknown camera driver 'gige'"), std::string::npos);
   EXPECT_NE(rig.error().message.find("sim"), std::string::npos);
+}
+
+TEST(RigTest, PoolErrorsAreRefusedNotThrown) {
+  RigOptions options = sixCameras();
+  options.pool_sets = 0;
+  auto rig = Rig::create(options, testing_support::camerasWithSim());
+  ASSERT_FALSE(rig.ok());
+  EXPECT_EQ(rig.error().message, "rig: frame pool: the buffer count must be positive");
+  options.pool_sets = std::numeric_limits<std::size_t>::max();  // the product would wrap
+  rig = Rig::create(options, testing_support::camerasWithSim());
+  ASSERT_FALSE(rig.ok());
+  EXPECT_NE(rig.error().message.find("cameras exceed the 65534 buffers a pool can hold"),
+            std::string::npos)
+      << rig.error().message;
 }
 
 }  // namespace

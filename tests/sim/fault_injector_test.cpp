@@ -56,8 +56,8 @@ bool isPattern(const core::Frame& frame) {
 }
 
 TEST(FaultInjectorTest, WithoutFaultsTheSourcesFrameComesThroughAsItIs) {
-  core::FramePool pool(1, std::size_t{kWidth} * kHeight);
-  const auto frame = fillOne({}, triggerNumber(6), pool);
+  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
+  const auto frame = fillOne({}, triggerNumber(6), *pool);
   ASSERT_TRUE(frame && frame->buffer);
   EXPECT_EQ(frame->metadata.status, core::FrameStatus::kOk);
   EXPECT_EQ(frame->metadata.device_timestamp_ns, 1'000'000'000);
@@ -68,17 +68,17 @@ TEST(FaultInjectorTest, DropEveryNDeliversNothingForIdsDivisibleByNAndTakesNoBuf
   FaultOptions faults;
   faults.drop_every = 3;
   FaultInjector source = patternWith(faults);
-  core::FramePool pool(8, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(8, std::size_t{kWidth} * kHeight).value();
   std::vector<core::Frame> delivered;
   for (std::uint64_t id = 1; id <= 7; ++id) {
     core::Frame frame = frameFor(triggerNumber(id));
-    const bool filled = source.fill(triggerNumber(id), pool, frame);
+    const bool filled = source.fill(triggerNumber(id), *pool, frame);
     EXPECT_EQ(filled, id % 3 != 0) << "trigger " << id;
     if (filled)
       delivered.push_back(std::move(frame));
   }
-  ASSERT_EQ(delivered.size(), 5u);  // 1, 2, 4, 5, 7
-  EXPECT_EQ(pool.available(), 3u);  // the dropped triggers never took a buffer
+  ASSERT_EQ(delivered.size(), 5u);   // 1, 2, 4, 5, 7
+  EXPECT_EQ(pool->available(), 3u);  // the dropped triggers never took a buffer
   for (const core::Frame& frame : delivered)
     EXPECT_TRUE(isPattern(frame)) << "trigger " << frame.metadata.trigger_id;
 }
@@ -87,10 +87,10 @@ TEST(FaultInjectorTest, CorruptEveryNMarksThoseFramesAndKeepsTheirPixels) {
   FaultOptions faults;
   faults.corrupt_every = 2;
   FaultInjector source = patternWith(faults);
-  core::FramePool pool(4, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(4, std::size_t{kWidth} * kHeight).value();
   for (std::uint64_t id = 1; id <= 4; ++id) {
     core::Frame frame = frameFor(triggerNumber(id));
-    ASSERT_TRUE(source.fill(triggerNumber(id), pool, frame));
+    ASSERT_TRUE(source.fill(triggerNumber(id), *pool, frame));
     ASSERT_TRUE(frame.buffer);
     EXPECT_EQ(frame.metadata.status,
               id % 2 == 0 ? core::FrameStatus::kCorrupt : core::FrameStatus::kOk)
@@ -102,9 +102,9 @@ TEST(FaultInjectorTest, CorruptEveryNMarksThoseFramesAndKeepsTheirPixels) {
 TEST(FaultInjectorTest, AFrameDroppedForWantOfABufferStaysDroppedNotCorrupt) {
   FaultOptions faults;
   faults.corrupt_every = 1;
-  core::FramePool pool(1, std::size_t{kWidth} * kHeight);
-  const core::FrameBuffer held = pool.acquire();
-  const auto frame = fillOne(faults, triggerNumber(5), pool);
+  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
+  const core::FrameBuffer held = pool->acquire();
+  const auto frame = fillOne(faults, triggerNumber(5), *pool);
   ASSERT_TRUE(frame);
   EXPECT_FALSE(frame->buffer);
   EXPECT_EQ(frame->metadata.status, core::FrameStatus::kDropped);
@@ -113,8 +113,8 @@ TEST(FaultInjectorTest, AFrameDroppedForWantOfABufferStaysDroppedNotCorrupt) {
 TEST(FaultInjectorTest, ClockOffsetShiftsTheDeviceTimestampExactly) {
   FaultOptions faults;
   faults.clock_offset = 250us;
-  core::FramePool pool(1, std::size_t{kWidth} * kHeight);
-  const auto frame = fillOne(faults, triggerNumber(1), pool);
+  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
+  const auto frame = fillOne(faults, triggerNumber(1), *pool);
   ASSERT_TRUE(frame);
   EXPECT_EQ(frame->metadata.device_timestamp_ns, 1'000'000'000 + 250'000);
   EXPECT_EQ(frame->metadata.status, core::FrameStatus::kOk);
@@ -123,9 +123,9 @@ TEST(FaultInjectorTest, ClockOffsetShiftsTheDeviceTimestampExactly) {
 TEST(FaultInjectorTest, DelayHoldsTheFrameUntilItsTriggerPlusTheDelay) {
   FaultOptions faults;
   faults.delay = 30ms;
-  core::FramePool pool(1, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
   const core::SteadyTime issued = std::chrono::steady_clock::now();
-  const auto frame = fillOne(faults, triggerNumber(1, issued), pool);
+  const auto frame = fillOne(faults, triggerNumber(1, issued), *pool);
   EXPECT_GE(std::chrono::steady_clock::now(), issued + 30ms);
   ASSERT_TRUE(frame);
   EXPECT_TRUE(isPattern(*frame));

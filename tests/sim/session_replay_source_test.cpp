@@ -106,36 +106,36 @@ TEST_P(SessionReplaySourceTest, ServesTheRecordedSetsInOrderAndWrapsAround) {
   ASSERT_TRUE(camera1.ok()) << camera1.error().message;
   EXPECT_EQ((*camera0)->preloaded(), GetParam() > 0);
   EXPECT_EQ((*camera1)->preloaded(), GetParam() > 0);
-  core::FramePool pool(16, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(16, std::size_t{kWidth} * kHeight).value();
 
   for (std::uint64_t lap = 0; lap < 2; ++lap) {
     SCOPED_TRACE("lap " + std::to_string(lap));
     const std::uint64_t k = 3 * lap;
     // Set 0: both ok; camera 1 recorded 250 ns after camera 0.
-    Served s = serve(**camera0, pool, 0, k);
+    Served s = serve(**camera0, *pool, 0, k);
     ASSERT_TRUE(s.delivered);
     EXPECT_EQ(s.frame.metadata.status, core::FrameStatus::kOk);
     EXPECT_EQ(s.frame.metadata.format, core::PixelFormat::kMono8);
     EXPECT_EQ(s.frame.metadata.device_timestamp_ns, kIssuedNs);
     EXPECT_EQ(s.pixels, pixelsFrom(0));
-    s = serve(**camera1, pool, 1, k);
+    s = serve(**camera1, *pool, 1, k);
     ASSERT_TRUE(s.delivered);
     EXPECT_EQ(s.frame.metadata.status, core::FrameStatus::kOk);
     EXPECT_EQ(s.frame.metadata.device_timestamp_ns, kIssuedNs + 250);
     EXPECT_EQ(s.pixels, pixelsFrom(100));
     // Set 1: camera 0 corrupt with its pixels, camera 1 missing: nothing delivered.
-    s = serve(**camera0, pool, 0, k + 1);
+    s = serve(**camera0, *pool, 0, k + 1);
     ASSERT_TRUE(s.delivered);
     EXPECT_EQ(s.frame.metadata.status, core::FrameStatus::kCorrupt);
     EXPECT_EQ(s.pixels, pixelsFrom(20));
-    EXPECT_FALSE(serve(**camera1, pool, 1, k + 1).delivered);
+    EXPECT_FALSE(serve(**camera1, *pool, 1, k + 1).delivered);
     // Set 2: camera 0 dropped (no pixels), camera 1 the only frame with pixels: offset 0.
-    s = serve(**camera0, pool, 0, k + 2);
+    s = serve(**camera0, *pool, 0, k + 2);
     ASSERT_TRUE(s.delivered);
     EXPECT_EQ(s.frame.metadata.status, core::FrameStatus::kDropped);
     EXPECT_FALSE(s.frame.buffer);
     EXPECT_EQ(s.frame.metadata.format, core::PixelFormat::kMono8);
-    s = serve(**camera1, pool, 1, k + 2);
+    s = serve(**camera1, *pool, 1, k + 2);
     ASSERT_TRUE(s.delivered);
     EXPECT_EQ(s.frame.metadata.status, core::FrameStatus::kOk);
     EXPECT_EQ(s.frame.metadata.device_timestamp_ns, kIssuedNs);
@@ -150,9 +150,9 @@ TEST(SessionReplaySourceErrorsTest, ADryPoolGivesADroppedFrame) {
   const ScopedTempDir dir("replay_source_dry");
   auto source = SessionReplaySource::open(cameraConfig("0"), 0, writeSession(dir.path()), 64);
   ASSERT_TRUE(source.ok()) << source.error().message;
-  core::FramePool pool(1, std::size_t{kWidth} * kHeight);
-  const core::FrameBuffer held = pool.acquire();
-  const Served s = serve(**source, pool, 0, 0);
+  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
+  const core::FrameBuffer held = pool->acquire();
+  const Served s = serve(**source, *pool, 0, 0);
   ASSERT_TRUE(s.delivered);
   EXPECT_EQ(s.frame.metadata.status, core::FrameStatus::kDropped);
   EXPECT_FALSE(s.frame.buffer);
@@ -166,8 +166,8 @@ TEST(SessionReplaySourceErrorsTest, ADamagedFileIsAnErrorAtOpenOrACorruptFrameWh
   const auto file = session / recording::frameFileName(0, 1, "bottom_right");
   ASSERT_TRUE(std::filesystem::remove(file));
 
-  core::FramePool pool(2, std::size_t{kWidth} * kHeight);
-  const Served s = serve(**streamed, pool, 1, 0);
+  const auto pool = core::FramePool::create(2, std::size_t{kWidth} * kHeight).value();
+  const Served s = serve(**streamed, *pool, 1, 0);
   ASSERT_TRUE(s.delivered);
   EXPECT_EQ(s.frame.metadata.status, core::FrameStatus::kCorrupt);
   EXPECT_EQ(s.pixels, std::vector<std::uint8_t>(kWidth * kHeight, 0));

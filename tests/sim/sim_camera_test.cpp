@@ -74,14 +74,14 @@ TEST(SimCameraTest, OptionsOfOtherDriversAreLeftAloneAndIdsMustBeCameraIndices) 
 }
 
 TEST(SimCameraTest, StartingWithoutAConfigurationOrWithSmallBuffersIsAnError) {
-  core::FramePool pool(2, 16 * 8);
+  const auto pool = core::FramePool::create(2, 16 * 8).value();
   SimCamera unconfigured;
-  EXPECT_FALSE(unconfigured.start(pool, [](core::Frame&&) {}).ok());
+  EXPECT_FALSE(unconfigured.start(*pool, [](core::Frame&&) {}).ok());
   SimCamera camera;
   drivers::CameraConfig config = smallCamera();
   config.width = 32;
   ASSERT_TRUE(camera.configure(config).ok());
-  const auto started = camera.start(pool, [](core::Frame&&) {});
+  const auto started = camera.start(*pool, [](core::Frame&&) {});
   ASSERT_FALSE(started.ok());
   EXPECT_NE(started.error().message.find("smaller than a frame"), std::string::npos);
 }

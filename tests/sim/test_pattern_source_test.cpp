@@ -23,10 +23,10 @@ TEST(TestPatternSourceTest, PatternValuesWorkedOutByHand) {
 
 TEST(TestPatternSourceTest, EveryPixelIsThePatternOfTheFramesCameraAndTrigger) {
   TestPatternSource source(kWidth);
-  core::FramePool pool(2, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(2, std::size_t{kWidth} * kHeight).value();
   const SimTrigger trigger = triggerNumber(42);
   core::Frame frame = stampedFrame(trigger, 3, kWidth, kHeight, core::PixelFormat::kBayerRG8);
-  ASSERT_TRUE(source.fill(trigger, pool, frame));
+  ASSERT_TRUE(source.fill(trigger, *pool, frame));
   ASSERT_TRUE(frame.buffer);
   EXPECT_EQ(frame.metadata.status, core::FrameStatus::kOk);
   EXPECT_EQ(frame.metadata.format, core::PixelFormat::kBayerRG8);  // the configured one, kept
@@ -42,13 +42,13 @@ TEST(TestPatternSourceTest, EveryPixelIsThePatternOfTheFramesCameraAndTrigger) {
 
 TEST(TestPatternSourceTest, OtherCamerasAndTriggersGetOtherPixels) {
   TestPatternSource source(kWidth);
-  core::FramePool pool(3, std::size_t{kWidth} * kHeight);
+  const auto pool = core::FramePool::create(3, std::size_t{kWidth} * kHeight).value();
   core::Frame a = stampedFrame(triggerNumber(7), 0, kWidth, kHeight, core::PixelFormat::kMono8);
   core::Frame b = stampedFrame(triggerNumber(7), 1, kWidth, kHeight, core::PixelFormat::kMono8);
   core::Frame c = stampedFrame(triggerNumber(8), 0, kWidth, kHeight, core::PixelFormat::kMono8);
-  ASSERT_TRUE(source.fill(triggerNumber(7), pool, a));
-  ASSERT_TRUE(source.fill(triggerNumber(7), pool, b));
-  ASSERT_TRUE(source.fill(triggerNumber(8), pool, c));
+  ASSERT_TRUE(source.fill(triggerNumber(7), *pool, a));
+  ASSERT_TRUE(source.fill(triggerNumber(7), *pool, b));
+  ASSERT_TRUE(source.fill(triggerNumber(8), *pool, c));
   const auto bytes = [](const core::Frame& frame) {
     const auto span = frame.buffer.bytes().first(std::size_t{kWidth} * kHeight);
     return std::vector<std::uint8_t>(span.begin(), span.end());
@@ -59,10 +59,10 @@ TEST(TestPatternSourceTest, OtherCamerasAndTriggersGetOtherPixels) {
 
 TEST(TestPatternSourceTest, ADryPoolGivesADroppedFrameWithoutPixels) {
   TestPatternSource source(kWidth);
-  core::FramePool pool(1, std::size_t{kWidth} * kHeight);
-  const core::FrameBuffer held = pool.acquire();  // the pool's only buffer
+  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
+  const core::FrameBuffer held = pool->acquire();  // the pool's only buffer
   core::Frame frame = stampedFrame(triggerNumber(1), 0, kWidth, kHeight, core::PixelFormat::kMono8);
-  ASSERT_TRUE(source.fill(triggerNumber(1), pool, frame));  // delivered, as dropped
+  ASSERT_TRUE(source.fill(triggerNumber(1), *pool, frame));  // delivered, as dropped
   EXPECT_FALSE(frame.buffer);
   EXPECT_EQ(frame.metadata.status, core::FrameStatus::kDropped);
 }

@@ -108,7 +108,7 @@ int runSynth(const SynthArgs& args) {
     Json truth = sim::plotTruthJson(plot, options);
     truth["points"] = out.size();
     truth["frame"] = args.frame;
-    core::Result<bool> written = traits::writeText(args.truth, truth.dump(1) + "\n");
+    core::Result<void> written = traits::writeText(args.truth, truth.dump(1) + "\n");
     if (!written) {
       std::cerr << "fieldrig traits synth: " << written.error().message << '\n';
       return kExitBadInput;

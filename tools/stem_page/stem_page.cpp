@@ -339,7 +339,7 @@ HttpReply StemPage::saveMeasurement(const PathParams& params, const HttpRequest&
   record.diameter_mm = m.diameter_mm;
   record.time = nowIso8601();
   record.repeat = stem::nextRepeat(*records, s.name, record.stem_label);
-  if (core::Result<bool> appended = stem::appendMeasurement(s.csv, record); !appended)
+  if (core::Result<void> appended = stem::appendMeasurement(s.csv, record); !appended)
     reject(http::status::internal_server_error, appended.error().message);
   Json out = measurementsJson(s);
   out["saved"] = {

@@ -113,7 +113,7 @@ AravisCamera::~AravisCamera() {
   vendor_->releaseCamera();
 }
 
-core::Result<bool> AravisCamera::configure(const CameraConfig& config) {
+core::Result<void> AravisCamera::configure(const CameraConfig& config) {
   if (running_)
     return core::Error{"aravis camera " + config.id + ": configure while running"};
   if (config.width == 0 || config.height == 0)
@@ -243,10 +243,10 @@ core::Result<bool> AravisCamera::configure(const CameraConfig& config) {
   offset_x_ = *offset_x;
   offset_y_ = *offset_y;
   buffer_count_ = *buffers;
-  return true;
+  return {};
 }
 
-core::Result<bool> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
+core::Result<void> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
   if (running_)
     return core::Error{"aravis camera " + config_.id + ": already started"};
   if (vendor_->camera == nullptr)
@@ -296,7 +296,7 @@ core::Result<bool> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
     return featureError(config_, "AcquisitionStart", error);
   }
   trigger_worker_ = std::thread([this] { runTriggers(); });
-  return true;
+  return {};
 }
 
 void AravisCamera::stop() {

@@ -172,7 +172,7 @@ Dc1394Camera::~Dc1394Camera() {
     ::close(wake_fd_);
 }
 
-core::Result<bool> Dc1394Camera::configure(const CameraConfig& config) {
+core::Result<void> Dc1394Camera::configure(const CameraConfig& config) {
   const std::string who = "dc1394 camera " + config.id;
   if (running_)
     return core::Error{who + ": configure while running"};
@@ -337,10 +337,10 @@ core::Result<bool> Dc1394Camera::configure(const CameraConfig& config) {
       "{:.2f} Hz at most",
       who, formatGuid(device_->guid), mode_name, s.iso_speed_mbps, s.width, s.height,
       plan_.packet_bytes, plan_.packets_per_frame, plan_.max_rate_hz);
-  return true;
+  return {};
 }
 
-core::Result<bool> Dc1394Camera::start(core::FramePool& pool, FrameSink sink) {
+core::Result<void> Dc1394Camera::start(core::FramePool& pool, FrameSink sink) {
   const std::string who = "dc1394 camera " + formatGuid(device_ ? device_->guid : 0);
   if (running_)
     return core::Error{who + ": already started"};
@@ -379,7 +379,7 @@ core::Result<bool> Dc1394Camera::start(core::FramePool& pool, FrameSink sink) {
   }
   running_ = true;
   worker_ = std::thread([this] { run(); });
-  return true;
+  return {};
 }
 
 void Dc1394Camera::stop() {

@@ -170,7 +170,7 @@ core::Result<std::vector<MeasurementRecord>> readMeasurementLog(const std::files
   return records;
 }
 
-core::Result<bool> appendMeasurement(const std::filesystem::path& file,
+core::Result<void> appendMeasurement(const std::filesystem::path& file,
                                      const MeasurementRecord& record) {
   std::error_code ec;
   const bool fresh =
@@ -186,7 +186,7 @@ core::Result<bool> appendMeasurement(const std::filesystem::path& file,
   if (std::string failed = core::appendDurably(std::filesystem::absolute(file), text);
       !failed.empty())
     return core::Error{std::move(failed)};
-  return true;
+  return {};
 }
 
 core::Result<std::optional<MeasurementRecord>> removeLastMeasurement(

@@ -198,7 +198,7 @@ std::string formatGeoJson(const std::vector<PlotRecord>& records) {
   return formatGeoJson(toRows(records));
 }
 
-core::Result<bool> writeText(const std::string& path, const std::string& text) {
+core::Result<void> writeText(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out)
     return core::Error{path + ": cannot open for writing"};
@@ -206,7 +206,7 @@ core::Result<bool> writeText(const std::string& path, const std::string& text) {
   out.close();
   if (!out)
     return core::Error{path + ": write failed"};
-  return true;
+  return {};
 }
 
 }  // namespace fieldrig::traits

@@ -65,7 +65,7 @@ SimCamera::~SimCamera() {
   stop();
 }
 
-core::Result<bool> SimCamera::configure(const drivers::CameraConfig& config) {
+core::Result<void> SimCamera::configure(const drivers::CameraConfig& config) {
   if (running_)
     return core::Error{"sim camera " + config.id + ": configure while running"};
   if (config.width == 0 || config.height == 0) {
@@ -83,10 +83,10 @@ core::Result<bool> SimCamera::configure(const drivers::CameraConfig& config) {
   config_ = config;
   camera_index_ = index;
   source_ = std::move(source).value();
-  return true;
+  return {};
 }
 
-core::Result<bool> SimCamera::start(core::FramePool& pool, FrameSink sink) {
+core::Result<void> SimCamera::start(core::FramePool& pool, FrameSink sink) {
   if (running_)
     return core::Error{"sim camera " + config_.id + ": already started"};
   if (!source_)
@@ -99,7 +99,7 @@ core::Result<bool> SimCamera::start(core::FramePool& pool, FrameSink sink) {
   first_trigger_id_.reset();  // every start replays from the first set
   running_ = true;
   worker_ = std::thread([this] { run(); });
-  return true;
+  return {};
 }
 
 void SimCamera::stop() {

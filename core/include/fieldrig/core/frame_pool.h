@@ -3,7 +3,7 @@
 // A FramePool owns N equally sized pixel buffers. acquire() hands out a FrameBuffer: a counted
 // reference to one buffer. Copies share the buffer (the recorder and the live pipeline both hold
 // a FrameSet); when the last copy is destroyed the buffer returns to the pool. Nothing is
-// allocated after construction, and acquire() never blocks: an exhausted pool returns an empty
+// allocated after create(), and acquire() never blocks: an exhausted pool returns an empty
 // FrameBuffer and the caller counts a drop (STYLE.md items 3 and 5).
 //
 // Thread-safe: acquire() and FrameBuffer copies/destruction may happen on any threads. The pool
@@ -16,6 +16,8 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+
+#include "fieldrig/core/result.h"
 
 namespace fieldrig::core {
 
@@ -47,7 +49,14 @@ class FrameBuffer {
 
 class FramePool {
  public:
-  FramePool(std::size_t buffer_count, std::size_t buffer_bytes);
+  // Boost.Lockfree's fixed-size free list holds at most 65535 nodes and its queue keeps one
+  // node spare, so this many buffers can be queued.
+  static constexpr std::size_t kMaxBuffers = 65534;
+
+  // Allocates every buffer now. An error for no buffers, empty buffers, more than kMaxBuffers,
+  // or a total size that overflows or cannot be allocated.
+  static Result<std::unique_ptr<FramePool>> create(std::size_t buffer_count,
+                                                   std::size_t buffer_bytes);
   ~FramePool();
   FramePool(const FramePool&) = delete;
   FramePool& operator=(const FramePool&) = delete;
@@ -62,6 +71,7 @@ class FramePool {
 
  private:
   friend class FrameBuffer;
+  FramePool(std::size_t buffer_count, std::size_t buffer_bytes);
   void addReference(std::uint32_t index) noexcept;
   void dropReference(std::uint32_t index) noexcept;
   std::uint8_t* data(std::uint32_t index) const { return memory_.get() + index * buffer_bytes_; }

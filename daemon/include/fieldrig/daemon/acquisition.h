@@ -65,7 +65,7 @@ class Acquisition {
   ~Acquisition();
 
   // Starts the recorder (and processing, when given) and the rig.
-  core::Result<bool> start(ProcessSet process = {});
+  core::Result<void> start(ProcessSet process = {});
   // Triggers the next set for a location the planner chose: the event (location, fix, times)
   // travels with the set into the recording and to processing. Its trigger id is replaced by the
   // session's own numbering, which continues across reopenings. Never blocks.

@@ -40,9 +40,9 @@ class Camera {
 
   virtual ~Camera() = default;
   virtual std::string driverName() const = 0;
-  virtual core::Result<bool> configure(const CameraConfig& config) = 0;
+  virtual core::Result<void> configure(const CameraConfig& config) = 0;
   // Frames are written into buffers from `pool` and handed to `sink` on the driver's thread.
-  virtual core::Result<bool> start(core::FramePool& pool, FrameSink sink) = 0;
+  virtual core::Result<void> start(core::FramePool& pool, FrameSink sink) = 0;
   virtual void stop() = 0;
   // Software trigger for `trigger_id`; false if the camera cannot take it now (not started,
   // external trigger, queue full). Never blocks.

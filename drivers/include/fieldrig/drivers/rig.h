@@ -56,14 +56,15 @@ class Rig {
  public:
   using SetSink = std::function<void(core::FrameSet&& set)>;
 
-  // Creates and configures the cameras; errors name the camera and the problem.
+  // Allocates the frame pool, creates and configures the cameras; errors name the camera (or the
+  // pool) and the problem.
   static core::Result<std::unique_ptr<Rig>> create(const RigOptions& options,
                                                    const CameraRegistry& registry);
   ~Rig();
   Rig(const Rig&) = delete;
   Rig& operator=(const Rig&) = delete;
 
-  core::Result<bool> start(SetSink sink);
+  core::Result<void> start(SetSink sink);
   // Stops the cameras, emits what is pending (incomplete), joins the rig thread.
   void stop();
   // Triggers every camera for `event.trigger_id`; the event travels with the set (its sent_time
@@ -84,7 +85,8 @@ class Rig {
     core::SteadyTime issued{};
   };
 
-  Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras);
+  Rig(RigOptions options, std::vector<std::unique_ptr<Camera>> cameras,
+      std::unique_ptr<core::FramePool> pool);
   void run();
   void drainTriggers();
   void drainFrames();

@@ -36,14 +36,14 @@ class LocationMap {
   static core::Result<LocationMap> parse(std::string_view text, std::string_view source_name);
 
   // Writes the map (header, then one line per location); returns an error naming the file.
-  core::Result<bool> save(const std::filesystem::path& path) const;
+  core::Result<void> save(const std::filesystem::path& path) const;
   std::string toCsv() const;
   // One CSV line (with newline) for `location`, as toCsv() writes it; for append-as-you-go writers.
   std::string csvLine(const ImagingLocation& location) const;
   std::string csvHeader() const;
 
   // Adds a location; an error if its id is already used or its numbers are out of range.
-  core::Result<bool> add(ImagingLocation location);
+  core::Result<void> add(ImagingLocation location);
 
   const std::vector<ImagingLocation>& locations() const { return locations_; }
   const std::vector<std::string>& metadataColumns() const { return metadata_columns_; }

@@ -39,7 +39,7 @@ core::Result<std::vector<MeasurementRecord>> readMeasurementLog(const std::files
 
 // Appends one row (writing the header first when the file is new or empty) and waits until it
 // is on the disk. The error names the file.
-core::Result<bool> appendMeasurement(const std::filesystem::path& file,
+core::Result<void> appendMeasurement(const std::filesystem::path& file,
                                      const MeasurementRecord& record);
 
 // Removes the last row of `session` (rows of other sessions sharing the file stay), rewriting the

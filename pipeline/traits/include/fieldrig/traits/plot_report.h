@@ -45,6 +45,6 @@ std::string formatCsv(const std::vector<PlotRecord>& records);
 std::string formatGeoJson(const std::vector<PlotRecord>& records);
 
 // Write the text to `path`; the error names the file.
-core::Result<bool> writeText(const std::string& path, const std::string& text);
+core::Result<void> writeText(const std::string& path, const std::string& text);
 
 }  // namespace fieldrig::traits

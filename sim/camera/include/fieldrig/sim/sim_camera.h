@@ -30,8 +30,8 @@ class SimCamera final : public drivers::Camera {
   ~SimCamera() override;
 
   std::string driverName() const override { return "sim"; }
-  core::Result<bool> configure(const drivers::CameraConfig& config) override;
-  core::Result<bool> start(core::FramePool& pool, FrameSink sink) override;
+  core::Result<void> configure(const drivers::CameraConfig& config) override;
+  core::Result<void> start(core::FramePool& pool, FrameSink sink) override;
   void stop() override;
   bool trigger(std::uint64_t trigger_id) override;
   // The sim's "exposure" happens at `issued` for every camera, as with a broadcast on the bus:

@@ -67,8 +67,8 @@ class AravisCamera final : public Camera {
   AravisCamera& operator=(const AravisCamera&) = delete;
 
   std::string driverName() const override { return "aravis"; }
-  core::Result<bool> configure(const CameraConfig& config) override;
-  core::Result<bool> start(core::FramePool& pool, FrameSink sink) override;
+  core::Result<void> configure(const CameraConfig& config) override;
+  core::Result<void> start(core::FramePool& pool, FrameSink sink) override;
   void stop() override;
   bool trigger(std::uint64_t trigger_id) override;
 

@@ -54,8 +54,8 @@ class Dc1394Camera final : public Camera {
   Dc1394Camera& operator=(const Dc1394Camera&) = delete;
 
   std::string driverName() const override { return "dc1394"; }
-  core::Result<bool> configure(const CameraConfig& config) override;
-  core::Result<bool> start(core::FramePool& pool, FrameSink sink) override;
+  core::Result<void> configure(const CameraConfig& config) override;
+  core::Result<void> start(core::FramePool& pool, FrameSink sink) override;
   void stop() override;
   bool trigger(std::uint64_t trigger_id) override;
 
