@@ -33,11 +33,14 @@ class RigTest : public ::testing::Test {
       rig_->stop();
   }
 
+  enum class WaitForEachSet { kNo, kYes };
   // Starts a rig of `options` with the collector as its sink, triggers 1 … `triggers` (`pause`
-  // after each), waits for their sets, stops the rig and keeps the sets in sets_. Its fatal
-  // failures end only this call: call it through ASSERT_NO_FATAL_FAILURE.
+  // after each, and when asked the trigger's set), waits for their sets, stops the rig and keeps
+  // the sets in sets_. Its fatal failures end only this call: call it through
+  // ASSERT_NO_FATAL_FAILURE.
   void run(const RigOptions& options, std::uint64_t triggers,
-           std::chrono::milliseconds pause = std::chrono::milliseconds{0}) {
+           std::chrono::milliseconds pause = std::chrono::milliseconds{0},
+           WaitForEachSet wait_for_each_set = WaitForEachSet::kNo) {
     auto rig = Rig::create(options, testing_support::camerasWithSim());
     ASSERT_TRUE(rig.ok()) << rig.error().message;
     rig_ = std::move(*rig);
@@ -46,6 +49,9 @@ class RigTest : public ::testing::Test {
       ASSERT_TRUE(rig_->trigger(id));
       if (pause.count() > 0)
         std::this_thread::sleep_for(pause);
+      if (wait_for_each_set == WaitForEachSet::kYes) {
+        ASSERT_TRUE(collector_.waitFor(id));
+      }
     }
     ASSERT_TRUE(collector_.waitFor(triggers));
     rig_->stop();
@@ -183,10 +189,12 @@ TEST_F(RigTest, BuffersReturnEvenWhenTheSinkCopiesTheSet) {
 TEST_F(RigTest, ExhaustedPoolShowsAsDroppedFrames) {
   RigOptions options = sixCameras();
   options.pool_sets = 2;  // 12 buffers; the collector keeps every set: nothing returns to the pool
-  // Dropped frames are reported at once, so no set here waits for the timeout: a long one only
-  // keeps a loaded machine from cutting the two whole sets short.
+  // Each trigger waits for the set before it, so the first two triggers take all 12 buffers
+  // whatever the scheduling of the six camera threads (with a fixed pause, a late camera thread
+  // lets a later trigger's frame take its buffer). Dropped frames are reported at once; the long
+  // timeout only keeps a loaded machine from cutting the two whole sets short.
   options.frame_timeout = 2s;
-  ASSERT_NO_FATAL_FAILURE(run(options, 4, 5ms));
+  ASSERT_NO_FATAL_FAILURE(run(options, 4, std::chrono::milliseconds{0}, WaitForEachSet::kYes));
   const auto& sets = sets_;
   EXPECT_TRUE(sets[0].complete());
   EXPECT_TRUE(sets[1].complete());
@@ -212,7 +220,7 @@ TEST_F(RigTest, ConfigurationErrorsNameTheCameraAndDriver) {
   EXPECT_NE(rig.error().message.find("sim"), std::string::npos);
 }
 
-TEST(RigTest, PoolErrorsAreRefusedNotThrown) {
+TEST_F(RigTest, PoolErrorsAreRefusedNotThrown) {
   RigOptions options = sixCameras();
   options.pool_sets = 0;
   auto rig = Rig::create(options, testing_support::camerasWithSim());
