@@ -1,9 +1,10 @@
 #include "fieldrig/traits/plot_report.h"
 
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
+
+#include "fieldrig/core/durable_file.h"
 
 namespace fieldrig::traits {
 namespace {
@@ -199,13 +200,10 @@ std::string formatGeoJson(const std::vector<PlotRecord>& records) {
 }
 
 core::Result<void> writeText(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out)
-    return core::Error{path + ": cannot open for writing"};
-  out << text;
-  out.close();
-  if (!out)
-    return core::Error{path + ": write failed"};
+  // Through a temporary file and a rename: a kill or a full disk leaves the old file, never half
+  // of the new one.
+  if (std::string error = core::replaceFileAtomically(path, text); !error.empty())
+    return core::Error{error};
   return {};
 }
 
