@@ -1,6 +1,8 @@
 #include "fieldrig/recording/session_format.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 
 namespace fieldrig::recording {
 namespace {
@@ -85,8 +87,14 @@ IndexedFrame frameFrom(const Json& in) {
   IndexedFrame frame;
   frame.camera_index = in.at("camera").get<int>();
   frame.camera_name = in.at("name").get<std::string>();
-  if (!in.at("file").is_null())
+  if (!in.at("file").is_null()) {
     frame.file = in.at("file").get<std::string>();
+    // Readers join it to the session folder: a damaged or hand-edited index must not make them
+    // read (or verify, or replay) a file outside it.
+    const std::filesystem::path file(frame.file);
+    if (file.is_absolute() || std::find(file.begin(), file.end(), "..") != file.end())
+      throw std::invalid_argument("frame file '" + frame.file + "' is outside the session folder");
+  }
   frame.width = in.at("width").get<int>();
   frame.height = in.at("height").get<int>();
   const std::optional<core::PixelFormat> format =

@@ -78,6 +78,21 @@ TEST(SessionReaderTest, BadIndexLineNamesFileAndLine) {
   EXPECT_TRUE(contains(reader.error().message, index.string() + ":3:")) << reader.error().message;
   EXPECT_TRUE(contains(reader.error().message, "trigger_id")) << reader.error().message;
 
+  // A frame file outside the session folder, relative or absolute.
+  for (const std::string outside : {"../../etc/passwd", "/etc/passwd"}) {
+    std::string escaping = lines[1];
+    const std::size_t file_at = escaping.find("\"file\":\"");
+    ASSERT_NE(file_at, std::string::npos) << escaping;
+    const std::size_t value_at = file_at + std::string("\"file\":\"").size();
+    escaping.replace(value_at, escaping.find('"', value_at) - value_at, outside);
+    writeText(index, lines[0] + "\n" + escaping + "\n" + lines[2] + "\n");
+    reader = SessionReader::open(session);
+    ASSERT_FALSE(reader) << outside;
+    EXPECT_TRUE(contains(reader.error().message, index.string() + ":2:")) << reader.error().message;
+    EXPECT_TRUE(contains(reader.error().message, "outside the session folder"))
+        << reader.error().message;
+  }
+
   // Set numbers out of order (line 2 repeated).
   writeText(index, lines[0] + "\n" + lines[1] + "\n" + lines[1] + "\n");
   reader = SessionReader::open(session);
