@@ -158,14 +158,17 @@ void registerCalibrateCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--right", args->right, "Right images (paired with --left in sorted order)")
       ->required();
   cmd->add_option("--board", args->board, "Inner corners COLSxROWS")->capture_default_str();
-  cmd->add_option("--square", args->square, "Square size in metres")->capture_default_str();
+  cmd->add_option("--square", args->square, "Square size in metres")
+      ->capture_default_str()
+      ->check(finiteRange(0.001, 1.0));
   cmd->add_option("--out", args->out,
                   "Output folder (intrinsics.yml, extrinsics.yml); with --head-pair a YAML file")
       ->required();
   cmd->add_option("--drop-factor", args->drop_factor,
                   "Drop views whose error exceeds this × the median, then recalibrate; 0 keeps "
                   "all")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(finiteRange(0.0, 100.0));
   cmd->add_flag("--head-pair", args->head_pair,
                 "--left are head A's left-camera images, --right head B's left-camera images "
                 "of the same boards; writes B's frame → A's frame (b_to_a)");
