@@ -151,6 +151,10 @@ std::vector<BadInputCase> numberCases() {
        {"calibrate", "--left", "{dir}/l*.png", "--right", "{dir}/r*.png", "--out", "{out}",
         "--square", "nan"},
        "--square"},
+      {"CalibrateBoardHuge",
+       {"calibrate", "--left", "{dir}/l*.png", "--right", "{dir}/r*.png", "--out", "{out}",
+        "--board", "99999x99999"},
+       "--board"},
       {"CalibrateDropFactorNegative",
        {"calibrate", "--left", "{dir}/l*.png", "--right", "{dir}/r*.png", "--out", "{out}",
         "--drop-factor", "-1"},
@@ -296,6 +300,21 @@ INSTANTIATE_TEST_SUITE_P(Numbers, BadInputCli, ::testing::ValuesIn(numberCases()
 INSTANTIATE_TEST_SUITE_P(TraitsOptions, BadInputCli, ::testing::ValuesIn(traitsOptionCases()),
                          caseName);
 INSTANTIATE_TEST_SUITE_P(Paths, BadInputCli, ::testing::ValuesIn(pathCases()), caseName);
+
+// An exception nothing handles (here std::bad_alloc: a 400 MB frame pool under a 600 MB address
+// space limit, with flags that are all in range) ends as one line naming the command and what
+// failed, and exit 4 — before, the process aborted (exit 134).
+TEST(BadInputCliInternalError, OutOfMemoryIsOneLineAndExit4) {
+  ScopedTempDir dir("bad_input_cli_oom");
+  const std::string command =
+      "ulimit -v 600000; exec " + shellQuote(kFieldrigBinary) +
+      " acquire --count 1 --rate 10 --width 4096 --height 4096 --pool-sets 4 --out " +
+      shellQuote((dir / "session").string());
+  const CliRun run = runProgram("sh", {"-c", command}, dir.path());
+  EXPECT_EQ(run.exit_code, 4) << run.err;
+  ASSERT_EQ(run.err_lines.size(), 1U) << run.err;
+  EXPECT_EQ(run.err_lines[0], "fieldrig acquire: internal error: out of memory (std::bad_alloc)");
+}
 
 TEST(BadInputCliHelp, ListsTheExitCodes) {
   ScopedTempDir dir("bad_input_cli_help");

@@ -42,11 +42,16 @@ std::vector<std::string> expandGlob(const std::string& pattern) {
   return files;
 }
 
+// Printed calibration boards have tens of inner corners a side; thousands would make the corner
+// search run for ever on every image.
+constexpr int kMaxBoardCorners = 100;
+
 std::optional<cv::Size> parseBoard(const std::string& text) {
   int cols = 0, rows = 0;
   char x = 0;
   std::istringstream in(text);
-  if (!(in >> cols >> x >> rows) || (x != 'x' && x != 'X') || cols < 2 || rows < 2 || !in.eof()) {
+  if (!(in >> cols >> x >> rows) || (x != 'x' && x != 'X') || cols < 2 || rows < 2 ||
+      cols > kMaxBoardCorners || rows > kMaxBoardCorners || !in.eof()) {
     return std::nullopt;
   }
   return cv::Size(cols, rows);
@@ -123,7 +128,8 @@ int runCalibrate(const CalibrateArgs& args) {
   const char* who = "fieldrig calibrate: ";
   const auto board_size = parseBoard(args.board);
   if (!board_size) {
-    std::cerr << who << "--board '" << args.board << "' is not COLSxROWS (e.g. 9x6)\n";
+    std::cerr << who << "--board '" << args.board << "' is not COLSxROWS with each in [2, "
+              << kMaxBoardCorners << "] (e.g. 9x6)\n";
     return kExitBadInput;
   }
   if (!(args.square > 0))
