@@ -1,32 +1,85 @@
 // fieldrig: the command-line tool. Parses flags and dispatches to a subcommand's run function.
 #include <CLI/CLI.hpp>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <new>
+#include <string>
 
 #include "commands/commands.h"
 #include "fieldrig/core/logging.h"
 
+namespace {
+
+// "fieldrig map generate": the subcommands that were parsed, for the one line that says what
+// failed.
+std::string commandName(const CLI::App& app) {
+  std::string name = "fieldrig";
+  const CLI::App* at = &app;
+  for (auto parsed = at->get_subcommands(); !parsed.empty(); parsed = at->get_subcommands()) {
+    at = parsed.front();
+    name += " " + at->get_name();
+  }
+  return name;
+}
+
+// What the exception being handled says, on one line (cv::Exception ends with a line break).
+std::string currentExceptionMessage() {
+  std::string message;
+  try {
+    throw;
+  } catch (const std::bad_alloc&) {
+    message = "out of memory (std::bad_alloc)";
+  } catch (const std::exception& error) {
+    message = error.what();
+  } catch (...) {
+    message = "an exception that is not a std::exception";
+  }
+  for (char& c : message) {
+    if (c == '\n' || c == '\r')
+      c = ' ';
+  }
+  while (!message.empty() && message.back() == ' ')
+    message.pop_back();
+  return message;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  using namespace fieldrig::tools;
   CLI::App app{"fieldrig: GPS-triggered stereo phenotyping of row plots"};
+  app.footer(kExitCodesHelp);
   app.require_subcommand(1);
   std::string log_level = "warn";
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
       ->capture_default_str();
   app.parse_complete_callback([&] { fieldrig::core::setupLogging(log_level); });
 
-  int exit_code = fieldrig::tools::kExitOk;
-  fieldrig::tools::registerNmeaCommand(app, exit_code);
-  fieldrig::tools::registerMapCommand(app, exit_code);
-  fieldrig::tools::registerTriggersCommand(app, exit_code);
-  fieldrig::tools::registerSimCommand(app, exit_code);
-  fieldrig::tools::registerAcquireCommand(app, exit_code);
-  fieldrig::tools::registerSessionCommand(app, exit_code);
-  fieldrig::tools::registerCalibrateCommand(app, exit_code);
-  fieldrig::tools::registerDisparityCommand(app, exit_code);
-  fieldrig::tools::registerCloudCommand(app, exit_code);
-  fieldrig::tools::registerTraitsCommand(app, exit_code);
-  fieldrig::tools::registerStemCommand(app, exit_code);
-  fieldrig::tools::registerStemUiCommand(app, exit_code);
-  fieldrig::tools::registerProcessCommand(app, exit_code);
-  fieldrig::tools::registerSimulateCommand(app, exit_code);
-  CLI11_PARSE(app, argc, argv);
+  int exit_code = kExitOk;
+  registerNmeaCommand(app, exit_code);
+  registerMapCommand(app, exit_code);
+  registerTriggersCommand(app, exit_code);
+  registerSimCommand(app, exit_code);
+  registerAcquireCommand(app, exit_code);
+  registerSessionCommand(app, exit_code);
+  registerCalibrateCommand(app, exit_code);
+  registerDisparityCommand(app, exit_code);
+  registerCloudCommand(app, exit_code);
+  registerTraitsCommand(app, exit_code);
+  registerStemCommand(app, exit_code);
+  registerStemUiCommand(app, exit_code);
+  registerProcessCommand(app, exit_code);
+  registerSimulateCommand(app, exit_code);
+  // The run functions are CLI11 callbacks, so whatever they let escape arrives here too.
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    // --help is a ParseError with exit code 0; every other one is an option that cannot be used.
+    return app.exit(error) == 0 ? kExitOk : kExitBadInput;
+  } catch (...) {
+    std::cerr << commandName(app) << ": internal error: " << currentExceptionMessage() << '\n';
+    return kExitInternal;
+  }
   return exit_code;
 }

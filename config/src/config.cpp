@@ -203,17 +203,24 @@ class Value {
 
 // --- Range-checked readers ----------------------------------------------------------------------
 
-double readPositive(const Value& v) {
+// Every number of the file is finite (Value::number) and bounded above too: a value beyond `hi`
+// is a typo or a unit mistake that would otherwise make the daemon wait, allocate or miss for
+// ever. The defaults of `hi` are for the few values with no natural ceiling.
+double readPositive(const Value& v, double hi = std::numeric_limits<double>::max()) {
   const double x = v.number();
   if (!(x > 0))
     v.fail(v.node().Scalar() + " must be positive");
+  if (x > hi)
+    v.fail(v.node().Scalar() + " is out of range (0, " + formatNumber(hi) + "]");
   return x;
 }
 
-double readNonNegative(const Value& v) {
+double readNonNegative(const Value& v, double hi = std::numeric_limits<double>::max()) {
   const double x = v.number();
   if (x < 0)
     v.fail(v.node().Scalar() + " must not be negative");
+  if (x > hi)
+    v.fail(v.node().Scalar() + " is out of range [0, " + formatNumber(hi) + "]");
   return x;
 }
 
@@ -331,14 +338,11 @@ Entries readMap(const Value& section, const Handlers& handlers) {
 }
 
 // Handlers that store into a field.
-Handler positive(double& field) {
-  return [&field](const Value& v) { field = readPositive(v); };
+Handler positive(double& field, double hi = std::numeric_limits<double>::max()) {
+  return [&field, hi](const Value& v) { field = readPositive(v, hi); };
 }
-Handler nonNegative(double& field) {
-  return [&field](const Value& v) { field = readNonNegative(v); };
-}
-Handler anyNumber(double& field) {
-  return [&field](const Value& v) { field = v.number(); };
+Handler nonNegative(double& field, double hi = std::numeric_limits<double>::max()) {
+  return [&field, hi](const Value& v) { field = readNonNegative(v, hi); };
 }
 Handler numberIn(double& field, double lo, double hi, bool hi_open = false) {
   return [&field, lo, hi, hi_open](const Value& v) { field = readNumberIn(v, lo, hi, hi_open); };
@@ -368,6 +372,17 @@ const Value& entryOr(const Entries& entries, std::string_view key, const Value& 
 
 constexpr unsigned kStandardBaudRates[] = {4800, 9600, 19200, 38400, 57600, 115200};
 
+// Ceilings shared by several keys: an hour between serial retries, a minute for anything the
+// trigger chain or a camera waits for, a second of lead or latency (a plot is passed in ~2 s).
+constexpr std::int64_t kMaxRetryMs = 3'600'000;
+constexpr std::int64_t kMaxFrameTimeoutMs = 60'000;
+constexpr double kMaxWaitS = 60;
+constexpr double kMaxLeadS = 1;
+// As `fieldrig acquire`: the largest machine-vision sensors are ~14k pixels wide, and the frame
+// pool's own budget check refuses what does not fit in memory.
+constexpr int kMaxFrameSide = 16384;
+constexpr std::int64_t kMaxPoolSets = 1024;
+
 void readSerial(const Value& section, gps::SerialOptions& serial) {
   const Entries entries = readMap(
       section,
@@ -387,13 +402,12 @@ void readSerial(const Value& section, gps::SerialOptions& serial) {
            }},
           {"reopen_initial_ms",
            [&](const Value& v) {
-             serial.reopen_initial_delay = std::chrono::milliseconds{
-                 readIntegerIn(v, 1, std::numeric_limits<std::int64_t>::max())};
+             serial.reopen_initial_delay =
+                 std::chrono::milliseconds{readIntegerIn(v, 1, kMaxRetryMs)};
            }},
           {"reopen_max_ms",
            [&](const Value& v) {
-             serial.reopen_max_delay = std::chrono::milliseconds{
-                 readIntegerIn(v, 1, std::numeric_limits<std::int64_t>::max())};
+             serial.reopen_max_delay = std::chrono::milliseconds{readIntegerIn(v, 1, kMaxRetryMs)};
            }},
       });
   if (serial.reopen_max_delay < serial.reopen_initial_delay) {
@@ -408,24 +422,24 @@ void readSerial(const Value& section, gps::SerialOptions& serial) {
 
 void readPlanner(const Value& section, gps::TriggerOptions& o) {
   readMap(section, {
-                       {"cross_track_tolerance_m", positive(o.cross_track_tolerance_m)},
+                       {"cross_track_tolerance_m", positive(o.cross_track_tolerance_m, 100)},
                        {"heading_tolerance_deg", numberIn(o.heading_tolerance_deg, 0, 180)},
-                       {"min_speed_mps", nonNegative(o.min_speed_mps)},
-                       {"max_fix_age_s", positive(o.max_fix_age_s)},
-                       {"max_fix_gap_s", positive(o.max_fix_gap_s)},
-                       {"min_trigger_interval_s", nonNegative(o.min_trigger_interval_s)},
-                       {"late_tolerance_m", nonNegative(o.late_tolerance_m)},
-                       {"rearm_distance_m", nonNegative(o.rearm_distance_m)},
-                       {"fit_window_s", positive(o.fit_window_s)},
-                       {"fit_residual_limit_m", positive(o.fit_residual_limit_m)},
-                       {"trigger_lead_s", nonNegative(o.trigger_lead_s)},
+                       {"min_speed_mps", nonNegative(o.min_speed_mps, 50)},
+                       {"max_fix_age_s", positive(o.max_fix_age_s, kMaxWaitS)},
+                       {"max_fix_gap_s", positive(o.max_fix_gap_s, kMaxWaitS)},
+                       {"min_trigger_interval_s", nonNegative(o.min_trigger_interval_s, kMaxWaitS)},
+                       {"late_tolerance_m", nonNegative(o.late_tolerance_m, 100)},
+                       {"rearm_distance_m", nonNegative(o.rearm_distance_m, 1000)},
+                       {"fit_window_s", positive(o.fit_window_s, kMaxWaitS)},
+                       {"fit_residual_limit_m", positive(o.fit_residual_limit_m, 100)},
+                       {"trigger_lead_s", nonNegative(o.trigger_lead_s, kMaxLeadS)},
                    });
 }
 
 void readGps(const Value& section, GpsConfig& gps) {
   readMap(section, {
                        {"serial", [&](const Value& v) { readSerial(v, gps.serial); }},
-                       {"latency_s", nonNegative(gps.triggers.latency_s)},
+                       {"latency_s", nonNegative(gps.triggers.latency_s, kMaxLeadS)},
                        {"planner", [&](const Value& v) { readPlanner(v, gps.triggers.planner); }},
                    });
 }
@@ -497,11 +511,11 @@ void readCameras(const Value& section, CamerasConfig& cameras) {
                }},
               {"width",
                [&](const Value& v) {
-                 shared.width = static_cast<std::uint32_t>(readInt(v, 1, 65535));
+                 shared.width = static_cast<std::uint32_t>(readInt(v, 1, kMaxFrameSide));
                }},
               {"height",
                [&](const Value& v) {
-                 shared.height = static_cast<std::uint32_t>(readInt(v, 1, 65535));
+                 shared.height = static_cast<std::uint32_t>(readInt(v, 1, kMaxFrameSide));
                }},
               {"pixel_format",
                [&](const Value& v) {
@@ -513,15 +527,15 @@ void readCameras(const Value& section, CamerasConfig& cameras) {
                  }
                  shared.format = *format;
                }},
-              {"exposure_us", positive(shared.exposure_us)},
-              {"gain_db", anyNumber(shared.gain_db)},
+              {"exposure_us", positive(shared.exposure_us, 10'000'000)},
+              {"gain_db", numberIn(shared.gain_db, -100, 100)},
               {"white_balance",
                [&](const Value& v) {
                  const std::vector<Value> gains = v.list();
                  if (gains.size() != 2)
                    v.fail("expected two gains [blue, red], got " + std::to_string(gains.size()));
                  shared.white_balance =
-                     std::make_pair(readPositive(gains[0]), readPositive(gains[1]));
+                     std::make_pair(readPositive(gains[0], 100), readPositive(gains[1], 100));
                }},
               {"trigger", choice(shared.trigger,
                                  Names<drivers::TriggerSource>{
@@ -530,18 +544,16 @@ void readCameras(const Value& section, CamerasConfig& cameras) {
                                  })},
               {"frame_timeout_ms",
                [&](const Value& v) {
-                 rig.frame_timeout = std::chrono::milliseconds{
-                     readIntegerIn(v, 1, std::numeric_limits<std::int64_t>::max())};
+                 rig.frame_timeout =
+                     std::chrono::milliseconds{readIntegerIn(v, 1, kMaxFrameTimeoutMs)};
                }},
               {"max_skew_us",
                [&](const Value& v) {
-                 rig.max_skew = std::chrono::microseconds{
-                     readIntegerIn(v, 0, std::numeric_limits<std::int64_t>::max())};
+                 rig.max_skew = std::chrono::microseconds{readIntegerIn(v, 0, 1'000'000)};
                }},
               {"pool_sets",
                [&](const Value& v) {
-                 rig.pool_sets = static_cast<std::size_t>(
-                     readIntegerIn(v, 1, std::numeric_limits<std::int64_t>::max()));
+                 rig.pool_sets = static_cast<std::size_t>(readIntegerIn(v, 1, kMaxPoolSets));
                }},
               {"options", [&](const Value& v) { shared.options = readCameraOptions(v); }},
           });
@@ -702,6 +714,13 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
     at.fail("the depth crop must satisfy crop_z_min_m (" + formatNumber(o.crop_z_min_m) +
             ") < crop_z_max_m (" + formatNumber(o.crop_z_max_m) + ")");
   }
+  // The ranges the traits steps are meant for live with the options (TraitsOptions::validate):
+  // the same for this file, the JSON of earlier versions and any program that fills them.
+  if (const auto problem = o.validate()) {
+    if (const auto it = entries.find(problem->key); it != entries.end())
+      it->second.fail(problem->message);
+    section.fail(problem->key + ": " + problem->message);
+  }
 }
 
 void readCloud(const Value& section, cloud::CloudOptions& o) {
@@ -731,8 +750,8 @@ void readPipeline(const Value& section, PipelineConfig& pipeline) {
                        {"enabled", flag(pipeline.enabled)},
                        {"queue_sets",
                         [&](const Value& v) {
-                          pipeline.queue_sets = static_cast<std::size_t>(
-                              readIntegerIn(v, 1, std::numeric_limits<std::int64_t>::max()));
+                          pipeline.queue_sets =
+                              static_cast<std::size_t>(readIntegerIn(v, 1, kMaxPoolSets));
                         }},
                        {"cloud", [&](const Value& v) { readCloud(v, pipeline.cloud); }},
                        {"matcher", [&](const Value& v) { readMatcher(v, pipeline.cloud.matcher); }},

@@ -28,8 +28,10 @@ int writeFully(int fd, const void* data, std::size_t size) {
   return 0;
 }
 
+// A bare file name ("drive.nmea") has an empty parent: its folder is the working directory.
 int syncDirectory(const std::filesystem::path& dir) {
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  const char* const name = dir.empty() ? "." : dir.c_str();
+  const int fd = ::open(name, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd < 0)
     return errno;
   const int result = ::fsync(fd) == 0 ? 0 : errno;

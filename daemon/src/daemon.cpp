@@ -386,6 +386,18 @@ class Daemon {
     watchSignals(signals, [this] { acquisition_->interruptWaits(); });
     notifier_.startWatchdog(control);
     std::thread control_thread([&control] { control.run(); });
+    // Stopped and joined on every way out: an exception from the replay (std::bad_alloc in a
+    // handler) that met a joinable thread would call std::terminate, and the unwinding that
+    // closes the session (~Acquisition) would never happen.
+    struct StopAndJoin {
+      boost::asio::io_context& io;
+      std::thread& thread;
+      ~StopAndJoin() {
+        io.stop();
+        if (thread.joinable())
+          thread.join();
+      }
+    } stop_and_join{control, control_thread};
     notifier_.ready();
 
     std::ifstream nmea(nmea_path, std::ios::binary);
@@ -410,8 +422,6 @@ class Daemon {
     } else {
       spdlog::error("{}: {}", sourceName(), summary.error().message);
     }
-    control.stop();
-    control_thread.join();
   }
 
   // Real time: the serial path of the field, from a device, or from a file played into a pty.

@@ -5,7 +5,10 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include <exception>
 #include <iostream>
+#include <new>
+#include <string>
 
 #include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/config/config.h"
@@ -16,7 +19,29 @@
 namespace {
 
 using fieldrig::daemon::kExitBadInput;
+using fieldrig::daemon::kExitInternal;
 using fieldrig::daemon::kExitOk;
+
+// What the exception being handled says, on one line (cv::Exception ends with a line break).
+std::string currentExceptionMessage() {
+  std::string message;
+  try {
+    throw;
+  } catch (const std::bad_alloc&) {
+    message = "out of memory (std::bad_alloc)";
+  } catch (const std::exception& error) {
+    message = error.what();
+  } catch (...) {
+    message = "an exception that is not a std::exception";
+  }
+  for (char& c : message) {
+    if (c == '\n' || c == '\r')
+      c = ' ';
+  }
+  while (!message.empty() && message.back() == ' ')
+    message.pop_back();
+  return message;
+}
 
 // The configuration and the files it names, as the daemon would load them at start.
 int checkConfig(const std::string& path) {
@@ -42,10 +67,13 @@ int checkConfig(const std::string& path) {
   return kExitOk;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+// `logging_ready` is set once the log (stderr and the configured file) is set up.
+int runMain(int argc, char** argv, bool& logging_ready) {
   CLI::App app{"fieldrigd: GPS-triggered stereo capture, recording and plot traits on the tractor"};
+  app.footer(
+      "Exit codes: 0 done (signal or end of replay); 2 bad configuration, option or input at "
+      "start (nothing written); 3 a failure while running; 4 internal error (an unexpected "
+      "exception, out of memory; the session is closed first).");
   std::string check_config;
   app.add_option("--check-config", check_config,
                  "Validate a configuration (and the map and calibration it names), then exit");
@@ -80,7 +108,12 @@ int main(int argc, char** argv) {
   replay->add_flag("--realtime", realtime,
                    "Play a file at its own pace (overrides replay.realtime)");
   app.require_subcommand(0, 1);
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    // --help is a ParseError with exit code 0; every other one is an option that cannot be used.
+    return app.exit(error) == 0 ? kExitOk : kExitBadInput;
+  }
 
   if (!check_config.empty())
     return checkConfig(check_config);
@@ -118,5 +151,30 @@ int main(int argc, char** argv) {
   options.print_results = !quiet;
   options.config = std::move(config);
   fieldrig::core::setupLogging(options.config.log.level, options.config.log.file.string());
+  logging_ready = true;
   return fieldrig::daemon::runDaemon(options);
+}
+
+}  // namespace
+
+// An exception that escapes runDaemon has unwound it: the Acquisition's destructor finished the
+// recording and closed the session on the way. What is left is to say so and exit non-zero.
+int main(int argc, char** argv) {
+  bool logging_ready = false;
+  try {
+    return runMain(argc, argv, logging_ready);
+  } catch (...) {
+    const std::string message = currentExceptionMessage();
+    // The log writes to stderr too: one line either way, and in the log file when there is one.
+    try {
+      if (logging_ready) {
+        spdlog::critical("fieldrigd: internal error: {}", message);
+        spdlog::shutdown();
+        return kExitInternal;
+      }
+    } catch (...) {  // a failing log must not turn a clean exit into an abort
+    }
+    std::cerr << "fieldrigd: internal error: " << message << '\n';
+    return kExitInternal;
+  }
 }

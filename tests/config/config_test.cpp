@@ -272,7 +272,7 @@ class ConfigErrors : public ::testing::Test {
     const std::string prefix = file.string() + ":" + std::to_string(line) + ": " +
                                (key_path.empty() ? "" : key_path + ": ");
     EXPECT_EQ(message.substr(0, prefix.size()), prefix) << message;
-    EXPECT_NE(message.find(what), std::string::npos) << message;
+    EXPECT_NE(message.find(what), std::string::npos) << message << "\ndoes not say: " << what;
   }
 };
 
@@ -350,6 +350,51 @@ TEST_F(ConfigErrors, OutOfRangeValuesAreRefused) {
   expectError("pipeline:\n  matcher:\n    mode: bm\n", 3, "pipeline.matcher.mode",
               "'bm' is not one of sgbm, hh, sgbm_3way or hh4");
   expectError("log:\n  level: verbose\n", 2, "log.level", "'verbose' is not one of trace");
+}
+
+// One policy for numbers (issue 17): finite, and bounded above as well as below, so that a typo
+// or a unit mistake is refused at start instead of making the daemon wait, allocate or miss.
+TEST_F(ConfigErrors, NumbersBeyondTheirCeilingOrNotFiniteAreRefusedWithTheRange) {
+  expectError("gps:\n  latency_s: nan\n", 2, "gps.latency_s", "nan is not a finite number");
+  expectError("gps:\n  latency_s: .nan\n", 2, "gps.latency_s", "expected a number, got '.nan'");
+  expectError("gps:\n  latency_s: 5\n", 2, "gps.latency_s", "5 is out of range [0, 1]");
+  expectError("gps:\n  planner:\n    trigger_lead_s: 1e9\n", 3, "gps.planner.trigger_lead_s",
+              "1e9 is out of range [0, 1]");
+  expectError("gps:\n  planner:\n    trigger_lead_s: .inf\n", 3, "gps.planner.trigger_lead_s",
+              "expected a number, got '.inf'");
+  expectError("gps:\n  planner:\n    cross_track_tolerance_m: 1e6\n", 3,
+              "gps.planner.cross_track_tolerance_m", "1e6 is out of range (0, 100]");
+  expectError("gps:\n  planner:\n    max_fix_age_s: 3600\n", 3, "gps.planner.max_fix_age_s",
+              "3600 is out of range (0, 60]");
+  expectError("gps:\n  serial:\n    reopen_max_ms: 99999999999\n", 3, "gps.serial.reopen_max_ms",
+              "99999999999 is out of range (1 … 3600000)");
+  expectError("cameras:\n  pool_sets: 70000\n", 2, "cameras.pool_sets",
+              "70000 is out of range (1 … 1024)");
+  expectError("cameras:\n  width: 100000\n", 2, "cameras.width",
+              "100000 is out of range (1 … 16384)");
+  expectError("cameras:\n  frame_timeout_ms: -1\n", 2, "cameras.frame_timeout_ms",
+              "-1 is out of range (1 … 60000)");
+  expectError("cameras:\n  gain_db: 1e300\n", 2, "cameras.gain_db",
+              "1e300 is out of range [-100, 100]");
+  expectError("pipeline:\n  queue_sets: 1000000\n", 2, "pipeline.queue_sets",
+              "1000000 is out of range (1 … 1024)");
+}
+
+// The traits options' own ranges (TraitsOptions::validate) reach the configuration with the key
+// and line of the value.
+TEST_F(ConfigErrors, TraitsOptionsOutsideTheirRangeNameTheKey) {
+  expectError("pipeline:\n  traits:\n    slices: 2000000000\n", 3, "pipeline.traits.slices",
+              "2000000000 is out of range [0, 1000]");
+  expectError("pipeline:\n  traits:\n    depth_map_cell_m: 1e-9\n", 3,
+              "pipeline.traits.depth_map_cell_m", "1e-09 is out of range [0.001, 1]");
+  expectError("pipeline:\n  traits:\n    icp_iterations: 100000000\n", 3,
+              "pipeline.traits.icp_iterations", "is out of range [1, 1000]");
+  expectError("pipeline:\n  traits:\n    outlier_stddev_mul: 1e9\n", 3,
+              "pipeline.traits.outlier_stddev_mul", "is out of range [0, 100]");
+  expectError("pipeline:\n  traits:\n    row_length_m: 1e6\n", 3, "pipeline.traits.row_length_m",
+              "is out of range [0.01, 100]");
+  expectError("pipeline:\n  traits:\n    row_length_m: -1\n", 3, "pipeline.traits.row_length_m",
+              "must be positive");
 }
 
 TEST_F(ConfigErrors, WrongNumberOfCameraIds) {
@@ -797,6 +842,13 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
   EXPECT_EQ(not_3x3.error().message.rfind(bad.string() + ":2: camera_to_plot: expected 3 rows", 0),
             0U)
       << not_3x3.error().message;
+
+  // A traits file alone gets the same ranges, named by key and line.
+  const fs::path huge = writeFile(dir / "huge.yaml", "alpha: 0.3\nslices: 2000000000\n");
+  const core::Result<traits::TraitsOptions> too_many = loadTraitsOptions(huge);
+  ASSERT_FALSE(too_many.ok());
+  EXPECT_EQ(too_many.error().message,
+            huge.string() + ":2: slices: 2000000000 is out of range [0, 1000]");
 
   const core::Result<traits::TraitsOptions> missing = loadTraitsOptions(dir / "none.yaml");
   ASSERT_FALSE(missing.ok());

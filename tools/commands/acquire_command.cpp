@@ -148,22 +148,30 @@ void registerAcquireCommand(CLI::App& app, int& exit_code) {
                   "camera id, once per camera in rig order (sim: default 0-5)");
   cmd->add_option("--count", args->count, "sets to trigger")
       ->required()
-      ->check(CLI::PositiveNumber);
+      ->check(finiteRange<std::uint64_t>(1, 10'000'000));
   cmd->add_option("--rate", args->rate_hz, "trigger rate, Hz")
       ->required()
-      ->check(CLI::PositiveNumber);
+      ->check(finiteRange(0.01, 1000.0));
   cmd->add_option("--out", args->out, "session folder (created, or continued)")->required();
   cmd->add_option("--fsync", args->fsync, "none, per_set or per_frame")->capture_default_str();
-  cmd->add_option("--width", args->width, "frame width")->capture_default_str();
-  cmd->add_option("--height", args->height, "frame height")->capture_default_str();
+  // The largest machine-vision sensors are about 14k pixels wide; the pool's own budget check
+  // refuses a rig whose frames, times the sets, do not fit in memory.
+  cmd->add_option("--width", args->width, "frame width")
+      ->capture_default_str()
+      ->check(finiteRange<std::uint32_t>(1, 16384));
+  cmd->add_option("--height", args->height, "frame height")
+      ->capture_default_str()
+      ->check(finiteRange<std::uint32_t>(1, 16384));
   cmd->add_option("--pixel-format", args->pixel_format, "GenICam pixel format")
       ->capture_default_str();
+  // Far below Boost.Lockfree's 65,535 free-list nodes even with a frame per camera per set.
   cmd->add_option("--pool-sets", args->pool_sets, "frame buffers allocated, in sets")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finiteRange<std::size_t>(1, 1024));
   cmd->add_option("--frame-timeout-ms", args->frame_timeout_ms,
                   "a set leaves incomplete this long after its trigger")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(finiteRange(1, 60'000));
   cmd->add_option("--camera-option", args->camera_options,
                   "KEY=VALUE for every camera (sim: drop_every, corrupt_every, delay_ms…)");
 }

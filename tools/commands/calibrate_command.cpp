@@ -42,11 +42,16 @@ std::vector<std::string> expandGlob(const std::string& pattern) {
   return files;
 }
 
+// Printed calibration boards have tens of inner corners a side; thousands would make the corner
+// search run for ever on every image.
+constexpr int kMaxBoardCorners = 100;
+
 std::optional<cv::Size> parseBoard(const std::string& text) {
   int cols = 0, rows = 0;
   char x = 0;
   std::istringstream in(text);
-  if (!(in >> cols >> x >> rows) || (x != 'x' && x != 'X') || cols < 2 || rows < 2 || !in.eof()) {
+  if (!(in >> cols >> x >> rows) || (x != 'x' && x != 'X') || cols < 2 || rows < 2 ||
+      cols > kMaxBoardCorners || rows > kMaxBoardCorners || !in.eof()) {
     return std::nullopt;
   }
   return cv::Size(cols, rows);
@@ -123,7 +128,8 @@ int runCalibrate(const CalibrateArgs& args) {
   const char* who = "fieldrig calibrate: ";
   const auto board_size = parseBoard(args.board);
   if (!board_size) {
-    std::cerr << who << "--board '" << args.board << "' is not COLSxROWS (e.g. 9x6)\n";
+    std::cerr << who << "--board '" << args.board << "' is not COLSxROWS with each in [2, "
+              << kMaxBoardCorners << "] (e.g. 9x6)\n";
     return kExitBadInput;
   }
   if (!(args.square > 0))
@@ -158,14 +164,17 @@ void registerCalibrateCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--right", args->right, "Right images (paired with --left in sorted order)")
       ->required();
   cmd->add_option("--board", args->board, "Inner corners COLSxROWS")->capture_default_str();
-  cmd->add_option("--square", args->square, "Square size in metres")->capture_default_str();
+  cmd->add_option("--square", args->square, "Square size in metres")
+      ->capture_default_str()
+      ->check(finiteRange(0.001, 1.0));
   cmd->add_option("--out", args->out,
                   "Output folder (intrinsics.yml, extrinsics.yml); with --head-pair a YAML file")
       ->required();
   cmd->add_option("--drop-factor", args->drop_factor,
                   "Drop views whose error exceeds this × the median, then recalibrate; 0 keeps "
                   "all")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(finiteRange(0.0, 100.0));
   cmd->add_flag("--head-pair", args->head_pair,
                 "--left are head A's left-camera images, --right head B's left-camera images "
                 "of the same boards; writes B's frame → A's frame (b_to_a)");

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -109,7 +110,8 @@ void registerCloudCommand(CLI::App& app, int& exit_code) {
       app, "cloud", "Fused three-head point cloud of one FrameSet in the plot frame (binary PLY)",
       exit_code, runCloud);
   cmd->add_option("session", args->session, "Recorded session folder");
-  cmd->add_option("--set", args->set, "Set index in the session");
+  cmd->add_option("--set", args->set, "Set index in the session")
+      ->check(finiteRange<std::int64_t>(0, std::numeric_limits<std::int64_t>::max()));
   cmd->add_option("--pairs", args->pairs, "L1,R1,L2,R2,L3,R3 image files, heads in rig order");
   cmd->add_option("--calib", args->calib,
                   "Calibration folder (rig.yml + one folder per head); for a session, "

@@ -4,6 +4,11 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <charconv>
+#include <cmath>
+#include <concepts>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -43,6 +48,49 @@ inline CLI::App* addCommandGroup(CLI::App& parent, std::string name, std::string
 inline int fail(std::string_view who, std::string_view message, int exit_code = kExitBadInput) {
   std::cerr << who << message << '\n';
   return exit_code;
+}
+
+// The one policy for numbers given on the command line: finite and inside [min, max], or an
+// error that CLI11 prefixes with the option's name ("--rate: must be a finite number in [0.01,
+// 1000], got nan"). CLI11's own Range, PositiveNumber and NonNegativeNumber compare with < and >,
+// which are false for NaN, so they let NaN (and, with the double's full range, inf) through.
+template <typename T>
+requires std::integral<T> || std::floating_point<T> CLI::Validator finiteRange(T min, T max) {
+  const auto text = [](T value) {
+    if constexpr (std::floating_point<T>) {
+      char buffer[32];
+      const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+      return ec == std::errc() ? std::string(buffer, end) : std::to_string(value);
+    } else {
+      return std::to_string(value);
+    }
+  };
+  const std::string kind = std::floating_point<T> ? "a finite number" : "a whole number";
+  const std::string range = "[" + text(min) + ", " + text(max) + "]";
+  return CLI::Validator(
+      [min, max, kind, range](std::string& input) {
+        T value{};
+        const bool converted = CLI::detail::lexical_cast(input, value);
+        bool finite = converted;
+        if constexpr (std::floating_point<T>)
+          finite = converted && std::isfinite(value);
+        if (!finite || value < min || value > max)
+          return "must be " + kind + " in " + range + ", got " + input;
+        return std::string{};
+      },
+      range);
+}
+
+// Opens a file given on the command line for reading; on failure, says why, naming the path. A
+// folder must be refused here: it opens and then reads as empty, which would pass for an empty
+// log. (fieldrigd reads its files through loaders that refuse folders themselves.)
+inline std::string openInputFile(const std::string& path, std::ifstream& in) {
+  if (std::error_code error; std::filesystem::is_directory(path, error))
+    return "'" + path + "' is a directory, not a file";
+  in.open(path, std::ios::binary);
+  if (!in)
+    return "cannot open '" + path + "'";
+  return {};
 }
 
 // Prints `line` as one line of JSON on stdout and gives the exit code back.

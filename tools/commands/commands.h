@@ -6,10 +6,15 @@
 
 namespace fieldrig::tools {
 
-// Exit codes shared by all subcommands.
+// Exit codes shared by all subcommands (and listed in `fieldrig --help`: kExitCodesHelp).
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitBadInput = 2;  // a file or option that cannot be used
 inline constexpr int kExitRuntime = 3;   // a failure while running (device lost for good…)
+inline constexpr int kExitInternal = 4;  // an exception nothing handled: a bug, or out of memory
+
+inline constexpr const char* kExitCodesHelp =
+    "Exit codes: 0 ok; 2 bad input (an option out of range, a file that cannot be used); "
+    "3 a failure while running; 4 internal error (an unexpected exception, out of memory).";
 
 void registerNmeaCommand(CLI::App& app, int& exit_code);
 void registerMapCommand(CLI::App& app, int& exit_code);

@@ -9,6 +9,13 @@
 
 namespace fieldrig::tools {
 
+// A breeding field is tens of rows of tens to hundreds of plots: these bounds leave room for the
+// largest while keeping a typo (--rows 2000000000) from running for hours.
+inline constexpr int kMaxFieldRows = 1000;
+inline constexpr int kMaxPlotsPerRow = 10'000;
+inline constexpr double kMaxFieldLocations = 100'000;
+inline constexpr double kMaxRowLengthM = 10'000;
+
 struct FieldPlanArgs {
   std::string row_start;  // "LAT,LON"
   std::string row_end;
@@ -20,7 +27,8 @@ struct FieldPlanArgs {
 // --start-offset, --left and --id-prefix to `command`, bound to `args`.
 void addFieldPlanOptions(CLI::App& command, FieldPlanArgs& args);
 
-// The plan with the row ends parsed; the error names the option that is wrong.
+// The plan with the row ends parsed; the error names the option that is wrong, also when the
+// plan would hold more than kMaxFieldLocations locations.
 core::Result<gps::FieldPlan> resolveFieldPlan(const FieldPlanArgs& args);
 
 }  // namespace fieldrig::tools

@@ -287,13 +287,17 @@ void registerMapCommand(CLI::App& app, int& exit_code) {
   auto r = std::make_shared<RecordOptions>();
   record->add_option("--nmea", r->nmea, "Serial device, FIFO or NMEA file")->required();
   record->add_option("--out", r->out, "Map file to write or continue")->required();
-  record->add_option("--baud", r->baud, "Serial baud rate")->capture_default_str();
+  record->add_option("--baud", r->baud, "Serial baud rate")
+      ->capture_default_str()
+      ->check(finiteRange(300u, 4'000'000u));
   record->add_option("--id-prefix", r->id_prefix, "Prefix of the ids <prefix><number>")
       ->capture_default_str();
-  CLI::Option* start_id = record->add_option(
-      "--start-id", r->start_id,
-      "First id number (default: one past the highest in the existing map, or 1); "
-      "numbers already used are skipped");
+  CLI::Option* start_id =
+      record
+          ->add_option("--start-id", r->start_id,
+                       "First id number (default: one past the highest in the existing map, or 1); "
+                       "numbers already used are skipped")
+          ->check(finiteRange(1L, 999'999'999L));
   record->add_flag("--realtime,!--no-realtime", r->realtime,
                    "Replay a file at the pace of its GPS times (default) or as fast as possible");
   record->callback([r, start_id, &exit_code] {

@@ -68,11 +68,9 @@ Json ggaJson(const gps::Sentence& s) {
 }
 
 int runDecode(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::cerr << "fieldrig nmea decode: cannot open '" << path << "'\n";
-    return kExitBadInput;
-  }
+  std::ifstream in;
+  if (const std::string problem = openInputFile(path, in); !problem.empty())
+    return fail("fieldrig nmea decode: ", problem);
   // A file is a capture: its '#' header lines (gpsd logs, recordings) are comments, not noise.
   gps::NmeaParserOptions options;
   options.comment_lines = true;

@@ -71,16 +71,16 @@ void registerSimCommand(CLI::App& app, int& exit_code) {
   sim::DriveOptions& d = args->drive;
   drive->add_option("--speed", d.speed_mps, "Ground speed, m/s")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finiteRange(0.1, 30.0));
   drive->add_option("--rate", d.rate_hz, "Fix rate, Hz")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finiteRange(0.1, 100.0));
   drive->add_option("--noise", d.position_noise_m, "Position noise (SD per axis), m")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteRange(0.0, 100.0));
   drive->add_option("--headland", d.headland_m, "Straight run-in/out beyond each row end, m")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteRange(0.0, 1000.0));
   drive->add_option("--seed", d.seed, "Noise seed")->capture_default_str();
   drive->add_option("--talker", d.talker, "NMEA talker id")->capture_default_str();
   drive->add_option("--start", args->start, "GPS time of the first fix (ISO-8601 UTC)");

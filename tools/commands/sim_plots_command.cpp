@@ -26,7 +26,7 @@ void addHeightRangeOptions(CLI::App& command, double& min_m, double& max_m) {
         std::tuple{"--height-max", &max_m, "Plant height of the last plot, m"}}) {
     command.add_option(name, *value, description)
         ->capture_default_str()
-        ->check(CLI::Range(0.3, 2.8));
+        ->check(finiteRange(0.3, 2.8));
   }
 }
 
@@ -87,7 +87,7 @@ void registerSimPlotsSubcommand(CLI::App& sim, int& exit_code) {
                     "Calibration folder to write (default SESSION/calib)");
   plots->add_option("--count", args->series.count, "Number of plots")
       ->capture_default_str()
-      ->check(CLI::Range(1, 1000));
+      ->check(finiteRange(1, 1000));
   plots->add_option("--seed", args->series.seed, "Scene seed")->capture_default_str();
   addHeightRangeOptions(*plots, args->series.height_min_m, args->series.height_max_m);
 }
@@ -100,16 +100,16 @@ void registerSimulateCommand(CLI::App& app, int& exit_code) {
   simulate->add_option("--out", args->out, "Folder to write")->required();
   simulate->add_option("--plots", args->spec.plots, "Number of plots")
       ->capture_default_str()
-      ->check(CLI::Range(1, 2000));
+      ->check(finiteRange(1, 2000));
   simulate->add_option("--rows", args->spec.rows, "Rows the plots are laid out in (serpentine)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 200));
+      ->check(finiteRange(1, 200));
   simulate->add_option("--seed", args->spec.seed, "Seed of the drive noise and the scenes")
       ->capture_default_str();
   addHeightRangeOptions(*simulate, args->spec.height_min_m, args->spec.height_max_m);
   simulate->add_option("--speed", args->spec.speed_mps, "Ground speed, m/s")
       ->capture_default_str()
-      ->check(CLI::Range(0.5, 5.0));
+      ->check(finiteRange(0.5, 5.0));
 }
 
 }  // namespace fieldrig::tools

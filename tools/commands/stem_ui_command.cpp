@@ -53,7 +53,9 @@ void registerStemUiCommand(CLI::App& app, int& exit_code) {
       "Serve the stem measurement page for recorded sessions (http://127.0.0.1:PORT/)", exit_code,
       runStemUi);
   command->add_option("sessions", args->page.sessions, "Session folders")->required();
-  command->add_option("--port", args->port, "TCP port (0: any free port)")->capture_default_str();
+  command->add_option("--port", args->port, "TCP port (0: any free port)")
+      ->capture_default_str()
+      ->check(finiteRange(0, 65535));
   command->add_option("--bind", args->bind, "Address to listen on")->capture_default_str();
   command->add_option("--calib", args->page.calib,
                       "Calibration folder: DIR/{bottom,middle,top}/{intrinsics,extrinsics}.yml");

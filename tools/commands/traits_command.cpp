@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "commands/commands.h"
+#include "commands/command_helpers.h"
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/config/config.h"
 #include "fieldrig/sim/plot_generator.h"
@@ -55,6 +55,8 @@ int runTraits(const TraitsArgs& args) {
     options.area_method = traits::AreaMethod::kPaperMlsGpt;
   else if (args.area == "depth_map")
     options.area_method = traits::AreaMethod::kDepthMap;
+  if (const auto problem = options.validate())
+    return fail("fieldrig traits: ", args.config + ": " + problem->key + ": " + problem->message);
   core::Result<std::vector<Eigen::Vector3f>> cloud = traits::loadCloud(args.cloud);
   if (!cloud) {
     std::cerr << "fieldrig traits: " << cloud.error().message << '\n';
@@ -146,19 +148,21 @@ void registerTraitsCommand(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"plot", "camera"}))
       ->capture_default_str();
   synth->add_option("--height", synth_args->spec.plant_height_m, "Plant height, m")
-      ->check(CLI::Range(0.2, 5.0))
+      ->check(finiteRange(0.2, 5.0))
       ->capture_default_str();
   synth->add_option("--noise", synth_args->spec.depth_noise_m, "Depth noise sigma, m")
-      ->check(CLI::Range(0.0, 0.05))
+      ->check(finiteRange(0.0, 0.05))
       ->capture_default_str();
   synth->add_option("--row-length", synth_args->spec.row_length_m, "Imaged row length, m")
-      ->check(CLI::Range(0.1, 10.0))
+      ->check(finiteRange(0.1, 10.0))
       ->capture_default_str();
-  synth->add_option("--tall-plant", synth_args->spec.tall_plant,
-                    "Index of one abnormal tall plant");
-  synth->add_option("--missing", synth_args->spec.missing_plants, "Indices of missing plants");
+  synth->add_option("--tall-plant", synth_args->spec.tall_plant, "Index of one abnormal tall plant")
+      ->check(finiteRange(-1, 1000));
+  synth->add_option("--missing", synth_args->spec.missing_plants, "Indices of missing plants")
+      ->check(finiteRange(0, 1000));
   synth->add_option("--seed", synth_args->spec.seed, "Random seed")->capture_default_str();
-  synth->add_option("--points", synth_args->points, "Keep this many points (random)");
+  synth->add_option("--points", synth_args->points, "Keep this many points (random)")
+      ->check(finiteRange<std::size_t>(0, 100'000'000));
   synth->add_flag("--no-plants", synth_args->no_plants, "Soil only");
   synth->callback([synth_args, &exit_code] { exit_code = runSynth(*synth_args); });
 

@@ -113,11 +113,9 @@ int runTriggers(const TriggersArgs& args) {
   std::error_code type_error;  // an unreadable path is reported below as "cannot open"
   if (std::filesystem::is_character_file(args.nmea_path, type_error))
     return runLive(args, *map);
-  std::ifstream nmea(args.nmea_path, std::ios::binary);
-  if (!nmea) {
-    std::cerr << "fieldrig triggers: cannot open NMEA file '" << args.nmea_path << "'\n";
-    return kExitBadInput;
-  }
+  std::ifstream nmea;
+  if (const std::string problem = openInputFile(args.nmea_path, nmea); !problem.empty())
+    return fail("fieldrig triggers: NMEA file: ", problem);
 
   gps::ReplayHandlers handlers;
   handlers.on_trigger = [](const core::TriggerEvent& event) {
@@ -144,25 +142,29 @@ void registerTriggersCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--nmea", args->nmea_path,
                   "NMEA capture to replay in GPS time, or a serial device to run live")
       ->required();
-  cmd->add_option("--baud", args->baud, "serial baud rate (live)")->capture_default_str();
+  cmd->add_option("--baud", args->baud, "serial baud rate (live)")
+      ->capture_default_str()
+      ->check(finiteRange(300u, 4'000'000u));
   cmd->add_option("--latency", args->replay.latency_s, "receiver and serial latency, seconds")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finiteRange(0.0, 1.0));
   cmd->add_option("--cross-track", p.cross_track_tolerance_m, "cross-track tolerance, metres")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finiteRange(0.01, 100.0));
   cmd->add_option("--heading-tolerance", p.heading_tolerance_deg, "degrees")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 180.0));
+      ->check(finiteRange(0.0, 180.0));
   cmd->add_option("--min-speed", p.min_speed_mps, "m/s")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(finiteRange(0.01, 50.0));
   cmd->add_option("--min-interval", p.min_trigger_interval_s,
                   "minimum seconds between triggers (the cameras' rate)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteRange(0.0, 60.0));
+  // A camera's exposure delay is milliseconds; a second ahead is already 2-3 plots early.
   cmd->add_option("--lead", p.trigger_lead_s, "fire this many seconds before the crossing")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(finiteRange(0.0, 1.0));
 }
 
 }  // namespace fieldrig::tools

@@ -4,9 +4,11 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 
 #include "pcl_steps.h"
@@ -73,6 +75,82 @@ PlatePose initialPlatePose(const Points& points, double strip) {
 }
 
 }  // namespace
+
+namespace {
+
+// Counts print as written ("2000000000", not "2e+09"); lengths in their shortest exact form.
+std::string optionNumber(double value) {
+  if (std::isfinite(value) && value == std::trunc(value) && std::abs(value) < 1e15)
+    return std::to_string(static_cast<long long>(value));
+  char buffer[32];
+  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return ec == std::errc() ? std::string(buffer, end) : std::to_string(value);
+}
+
+// `value` in [lo, hi] (or [lo, hi) when hi_open), else the problem naming `key`.
+std::optional<OptionsProblem> outOfRange(const char* key, double value, double lo, double hi,
+                                         bool hi_open = false) {
+  if (std::isfinite(value) && value >= lo && value <= hi && !(hi_open && value == hi))
+    return std::nullopt;
+  return OptionsProblem{key, optionNumber(value) + " is out of range [" + optionNumber(lo) + ", " +
+                                 optionNumber(hi) + (hi_open ? ")" : "]")};
+}
+
+}  // namespace
+
+std::optional<OptionsProblem> TraitsOptions::validate() const {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      if (auto bad = outOfRange("camera_to_plot", camera_to_plot(r, c), -1e3, 1e3))
+        return bad;
+    }
+  }
+  // Lengths from a millimetre (below, voxels and cells outnumber any cloud's points) to what a
+  // side-view camera a metre or two from the row can see.
+  const std::optional<OptionsProblem> checks[] = {
+      outOfRange("voxel_leaf_m", voxel_leaf_m, 0.001, 1),
+      outOfRange("outlier_mean_k", outlier_mean_k, 1, 1000),
+      outOfRange("outlier_stddev_mul", outlier_stddev_mul, 0, 100),
+      outOfRange("outlier_min_neighbours", outlier_min_neighbours, 0, 26),
+      outOfRange("crop_z_max_m", crop_z_max_m, 0.01, 100),
+      outOfRange("crop_z_min_m", crop_z_min_m, 0, 100),
+      outOfRange("max_abs_coordinate_m", max_abs_coordinate_m, 1, 1e6),
+      outOfRange("template_strip_m", template_strip_m, 0.01, 10),
+      outOfRange("template_step_m", template_step_m, 0.001, 1),
+      outOfRange("icp_target_leaf_m", icp_target_leaf_m, 0.001, 1),
+      outOfRange("icp_coarse_distance_m", icp_coarse_distance_m, 0.001, 10),
+      outOfRange("icp_fine_distance_m", icp_fine_distance_m, 0, 10),
+      outOfRange("icp_iterations", icp_iterations, 1, 1000),
+      outOfRange("max_ground_tilt_deg", max_ground_tilt_deg, 0, 90),
+      outOfRange("ground_margin_m", ground_margin_m, 0, 1),
+      outOfRange("ground_tilt_deg", ground_tilt_deg, 0, 90, true),
+      outOfRange("row_length_m", row_length_m, 0.01, 100),
+      outOfRange("intra_row_spacing_m", intra_row_spacing_m, 0.001, 10),
+      // sliceCount's own ceiling for a count derived from the row.
+      outOfRange("slices", slices, 0, 1000),
+      outOfRange("min_row_extent_m", min_row_extent_m, 0, 100),
+      outOfRange("min_plant_points", static_cast<double>(min_plant_points), 0, 1e9),
+      outOfRange("alpha", alpha, 0, 1, true),
+      outOfRange("alpha_near_margin", alpha_near_margin, 0, 1),
+      outOfRange("depth_map_cell_m", depth_map_cell_m, 0.001, 1),
+      outOfRange("depth_map_max_step_m", depth_map_max_step_m, 0.001, 10),
+      outOfRange("depth_map_min_fill", depth_map_min_fill, 0, 1),
+      outOfRange("mls_radius_m", mls_radius_m, 0.001, 1),
+      outOfRange("gpt_radius_m", gpt_radius_m, 0.001, 1),
+      outOfRange("gpt_mu", gpt_mu, 0.1, 100),
+      outOfRange("gpt_max_neighbors", gpt_max_neighbors, 1, 10000),
+  };
+  for (const std::optional<OptionsProblem>& problem : checks) {
+    if (problem)
+      return problem;
+  }
+  if (!(crop_z_min_m < crop_z_max_m)) {
+    return OptionsProblem{"crop_z_min_m", "the depth crop must satisfy crop_z_min_m (" +
+                                              optionNumber(crop_z_min_m) + ") < crop_z_max_m (" +
+                                              optionNumber(crop_z_max_m) + ")"};
+  }
+  return std::nullopt;
+}
 
 int sliceCount(const TraitsOptions& options) {
   if (options.slices > 0)

@@ -34,11 +34,13 @@ struct DaemonOptions {
   bool print_results = true;  // one JSON line per plot on stdout (the summary line always)
 };
 
-// Exit codes: 0 done (signal or end of replay), 2 bad configuration or input at start (nothing
-// written), 3 a failure while running.
+// Exit codes: 0 done (signal or end of replay), 2 bad configuration, option or input at start
+// (nothing written), 3 a failure while running, 4 an internal error (an exception nothing
+// handled, out of memory: fieldrigd_main logs it; the session was closed while unwinding).
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitRuntime = 3;
+inline constexpr int kExitInternal = 4;
 
 int runDaemon(const DaemonOptions& options);
 

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,13 @@ enum class AreaMethod {
 enum class OutlierMethod {
   kStatistical,      // PCL StatisticalOutlierRemoval (the paper)
   kVoxelNeighbours,  // removeSparseOutliers below
+};
+
+// An option of TraitsOptions outside its range: its key as the configuration names it, and what
+// is wrong (the value and the allowed range), to be said after the key.
+struct OptionsProblem {
+  std::string key;      // "depth_map_cell_m"
+  std::string message;  // "1e-09 is out of range [0.001, 1]"
 };
 
 struct TraitsOptions {
@@ -63,6 +71,12 @@ struct TraitsOptions {
   double gpt_radius_m = 0.05;
   double gpt_mu = 2.5;
   int gpt_max_neighbors = 100;
+
+  // Every number finite and inside the range the steps are meant for (a 1e-9 m depth-map cell or
+  // two billion slices would run out of memory or time, a negative length mean nothing); the
+  // first option that is not, or nothing. The configuration loader calls it, so that no program
+  // takes such a value silently.
+  std::optional<OptionsProblem> validate() const;
 };
 
 // Fills slices from row length and spacing when it is 0 (equation 15).
