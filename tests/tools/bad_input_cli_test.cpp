@@ -301,19 +301,21 @@ INSTANTIATE_TEST_SUITE_P(TraitsOptions, BadInputCli, ::testing::ValuesIn(traitsO
                          caseName);
 INSTANTIATE_TEST_SUITE_P(Paths, BadInputCli, ::testing::ValuesIn(pathCases()), caseName);
 
-// An exception nothing handles (here std::bad_alloc: a 400 MB frame pool under a 600 MB address
-// space limit, with flags that are all in range) ends as one line naming the command and what
-// failed, and exit 4 — before, the process aborted (exit 134).
-TEST(BadInputCliInternalError, OutOfMemoryIsOneLineAndExit4) {
+// A 400 MB frame pool under a 600 MB address-space limit, with flags that are all in range: the
+// pool's allocation fails, and the run ends as one line naming the command and the size, exit 2.
+// Before, std::bad_alloc escaped and the process aborted (exit 134).
+TEST(BadInputCliInternalError, AFramePoolThatCannotBeAllocatedIsOneLineNamingItsSize) {
   ScopedTempDir dir("bad_input_cli_oom");
   const std::string command =
       "ulimit -v 600000; exec " + shellQuote(kFieldrigBinary) +
       " acquire --count 1 --rate 10 --width 4096 --height 4096 --pool-sets 4 --out " +
       shellQuote((dir / "session").string());
   const CliRun run = runProgram("sh", {"-c", command}, dir.path());
-  EXPECT_EQ(run.exit_code, 4) << run.err;
+  EXPECT_EQ(run.exit_code, 2) << run.err;
   ASSERT_EQ(run.err_lines.size(), 1U) << run.err;
-  EXPECT_EQ(run.err_lines[0], "fieldrig acquire: internal error: out of memory (std::bad_alloc)");
+  EXPECT_EQ(run.err_lines[0],
+            "fieldrig acquire: rig: frame pool: cannot allocate 24 buffers of 16777216 bytes "
+            "(402653184 bytes in all)");
 }
 
 TEST(BadInputCliHelp, ListsTheExitCodes) {
