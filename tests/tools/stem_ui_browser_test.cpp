@@ -19,8 +19,8 @@
 
 #include "fieldrig/recording/session_writer.h"
 #include "fieldrig/stem/measurement_log.h"
-#include "support/stem_campaign.h"
 #include "support/cli_run.h"
+#include "support/stem_campaign.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig {
