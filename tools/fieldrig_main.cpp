@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands/commands.h"
+#include "fieldrig/core/exception_message.h"
 #include "fieldrig/core/logging.h"
 
 namespace {
@@ -21,27 +22,6 @@ std::string commandName(const CLI::App& app) {
     name += " " + at->get_name();
   }
   return name;
-}
-
-// What the exception being handled says, on one line (cv::Exception ends with a line break).
-std::string currentExceptionMessage() {
-  std::string message;
-  try {
-    throw;
-  } catch (const std::bad_alloc&) {
-    message = "out of memory (std::bad_alloc)";
-  } catch (const std::exception& error) {
-    message = error.what();
-  } catch (...) {
-    message = "an exception that is not a std::exception";
-  }
-  for (char& c : message) {
-    if (c == '\n' || c == '\r')
-      c = ' ';
-  }
-  while (!message.empty() && message.back() == ' ')
-    message.pop_back();
-  return message;
 }
 
 }  // namespace
@@ -78,7 +58,8 @@ int main(int argc, char** argv) {
     // --help is a ParseError with exit code 0; every other one is an option that cannot be used.
     return app.exit(error) == 0 ? kExitOk : kExitBadInput;
   } catch (...) {
-    std::cerr << commandName(app) << ": internal error: " << currentExceptionMessage() << '\n';
+    std::cerr << commandName(app)
+              << ": internal error: " << fieldrig::core::currentExceptionMessage() << '\n';
     return kExitInternal;
   }
   return exit_code;

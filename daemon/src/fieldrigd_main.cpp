@@ -12,6 +12,7 @@
 
 #include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/config/config.h"
+#include "fieldrig/core/exception_message.h"
 #include "fieldrig/core/logging.h"
 #include "fieldrig/daemon/daemon.h"
 #include "fieldrig/gps/location_map.h"
@@ -21,27 +22,6 @@ namespace {
 using fieldrig::daemon::kExitBadInput;
 using fieldrig::daemon::kExitInternal;
 using fieldrig::daemon::kExitOk;
-
-// What the exception being handled says, on one line (cv::Exception ends with a line break).
-std::string currentExceptionMessage() {
-  std::string message;
-  try {
-    throw;
-  } catch (const std::bad_alloc&) {
-    message = "out of memory (std::bad_alloc)";
-  } catch (const std::exception& error) {
-    message = error.what();
-  } catch (...) {
-    message = "an exception that is not a std::exception";
-  }
-  for (char& c : message) {
-    if (c == '\n' || c == '\r')
-      c = ' ';
-  }
-  while (!message.empty() && message.back() == ' ')
-    message.pop_back();
-  return message;
-}
 
 // The configuration and the files it names, as the daemon would load them at start.
 int checkConfig(const std::string& path) {
@@ -164,7 +144,7 @@ int main(int argc, char** argv) {
   try {
     return runMain(argc, argv, logging_ready);
   } catch (...) {
-    const std::string message = currentExceptionMessage();
+    const std::string message = fieldrig::core::currentExceptionMessage();
     // The log writes to stderr too: one line either way, and in the log file when there is one.
     try {
       if (logging_ready) {
