@@ -183,23 +183,29 @@ TEST(DaemonLive, ProcessingSlowerThanTheDriveLosesNothingAndFieldrigProcessCompl
   const fs::path field = testing_support::daemonField();
   ASSERT_TRUE(fs::exists(field / "drive.nmea")) << "the daemon_field fixture did not run";
   ScopedTempDir dir("daemon_slow");
-  // The field driven at 6 m/s (a plot every 0.67 s, played in real time through the daemon's
-  // pty) and the paper's surface area (MLS + greedy triangulation, 2-3 s a plot here) behind a
-  // one-set queue: live processing must fall behind and skip, whatever the machine's load.
+  // A burst no processor keeps up with: 20 plots 0.9 m apart driven at 6 m/s (a set every
+  // 0.15 s for 3 s, played in real time through the daemon's pty; the cameras allowed 10 Hz),
+  // into a one-set queue, processed with the paper's surface area (MLS + greedy triangulation).
+  // A set takes about 1 s to process here; keeping up would take 0.15 s, so live processing falls
+  // behind and skips on any machine this runs on. The sim cameras replay the field's 12 sets in
+  // turn, whatever the map.
   const fs::path fast_nmea = dir.path() / "fast.nmea";
+  const fs::path fast_map = dir.path() / "fast-map.csv";
   gps::FieldPlan plan =
-      testing_support::fieldPlan({42.0106, -93.7385}, {42.0110, -93.7385}, 2, 3.0, 1.0);
-  plan.plots_per_row = 6;
+      testing_support::fieldPlan({42.0106, -93.7385}, {42.0110, -93.7385}, 1, 0.5, 1.0);
+  plan.plots_per_row = 20;
+  plan.alley_length_m = 0.4;
   const auto drive = testing_support::runFieldrig(
-      testing_support::withFieldPlan(
-          {"sim", "drive"}, plan,
-          {"--speed", "6", "--seed", "7", "--out-nmea", fast_nmea.string(), "--out-map",
-           (dir.path() / "fast-map.csv").string()}),
+      testing_support::withFieldPlan({"sim", "drive"}, plan,
+                                     {"--speed", "6", "--seed", "7", "--out-nmea",
+                                      fast_nmea.string(), "--out-map", fast_map.string()}),
       dir.path());
   ASSERT_EQ(drive.exit_code, 0) << drive.err;
-  const std::string slow_traits = "pipeline:\n  queue_sets: 1\n  traits:\n    area_method: paper\n";
+  const std::string slow_processing =
+      "gps:\n  planner:\n    min_trigger_interval_s: 0.1\n"
+      "pipeline:\n  queue_sets: 1\n  traits:\n    area_method: paper\n";
   const fs::path config =
-      testing_support::writeReplayConfig(dir.path(), "run", field, "", slow_traits);
+      testing_support::writeReplayConfig(dir.path(), "run", field, "", slow_processing, fast_map);
   const auto run = testing_support::runDaemon(
       {"replay", "--config", config.string(), "--realtime", "--nmea", fast_nmea.string()},
       dir.path());
@@ -222,10 +228,9 @@ TEST(DaemonLive, ProcessingSlowerThanTheDriveLosesNothingAndFieldrigProcessCompl
   const fs::path traits = dir.path() / "slow-traits.yaml";
   std::ofstream(traits) << "area_method: paper\n";
   const fs::path session = dir.path() / "run" / "session";
-  const auto completed =
-      testing_support::runFieldrig({"process", session.string(), "--traits-config", traits.string(),
-                                    "--map", (field / "map.csv").string()},
-                                   dir.path());
+  const auto completed = testing_support::runFieldrig(
+      {"process", session.string(), "--traits-config", traits.string(), "--map", fast_map.string()},
+      dir.path());
   ASSERT_EQ(completed.exit_code, 0) << completed.err;
   const Json offline = Json::parse(completed.out_lines.back()).at("summary");
   EXPECT_EQ(offline.at("already_done"), processed);

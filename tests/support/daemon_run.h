@@ -34,15 +34,16 @@ inline CliRun runDaemon(const std::vector<std::string>& args,
 }
 
 // DIR/NAME.yaml: replay of `field` into DIR/NAME/session, status on any free port. `extra` is
-// appended (more keys, or a section of its own).
+// appended (more keys, or a section of its own); `map` replaces the field's map when given.
 inline std::filesystem::path writeReplayConfig(const std::filesystem::path& dir,
                                                const std::string& name,
                                                const std::filesystem::path& field,
                                                const std::string& camera_options = "",
-                                               const std::string& extra = "") {
+                                               const std::string& extra = "",
+                                               const std::filesystem::path& map = {}) {
   const std::filesystem::path path = dir / (name + ".yaml");
   std::ofstream out(path);
-  out << "map: " << (field / "map.csv").string() << "\n"
+  out << "map: " << (map.empty() ? field / "map.csv" : map).string() << "\n"
       << "calibration: " << (field / "source-session" / "calib").string() << "\n"
       << "cameras:\n"
       << "  driver: sim\n"
