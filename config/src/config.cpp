@@ -684,6 +684,7 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
           {"ground_margin_m", nonNegative(o.ground_margin_m)},
           {"ground_tilt_deg", numberIn(o.ground_tilt_deg, 0, 90, true)},
           {"row_length_m", positive(o.row_length_m)},
+          {"crop_to_row_length", flag(o.crop_to_row_length)},
           {"intra_row_spacing_m", positive(o.intra_row_spacing_m)},
           {"slices", integer(o.slices, 0)},
           {"min_row_extent_m", nonNegative(o.min_row_extent_m)},

@@ -125,6 +125,7 @@ void expectSame(const traits::TraitsOptions& actual, const traits::TraitsOptions
   EXPECT_FIELD(ground_margin_m);
   EXPECT_FIELD(ground_tilt_deg);
   EXPECT_FIELD(row_length_m);
+  EXPECT_FIELD(crop_to_row_length);
   EXPECT_FIELD(intra_row_spacing_m);
   EXPECT_FIELD(slices);
   EXPECT_FIELD(min_row_extent_m);

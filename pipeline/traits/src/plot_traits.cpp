@@ -216,10 +216,25 @@ std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>&
   return out;
 }
 
-TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& plant_points, double x_min,
-                                   const TraitsOptions& options) {
+TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& all_plant_points,
+                                   double x_min, const TraitsOptions& options) {
   TraitsResult result;
   const auto slices_start = Clock::now();
+  // The plot is row_length_m long, centred on its location (y = 0): what lies beyond is the
+  // neighbouring plots' leaves and the ends of the cameras' view, where only the far side of the
+  // row is seen by both cameras of a head.
+  std::vector<Eigen::Vector3f> in_row;
+  if (options.crop_to_row_length) {
+    const double half = options.row_length_m / 2.0;
+    in_row.reserve(all_plant_points.size());
+    for (const Eigen::Vector3f& p : all_plant_points) {
+      if (std::abs(p.y()) <= half)
+        in_row.push_back(p);
+    }
+    result.quality.points_beyond_row = all_plant_points.size() - in_row.size();
+  }
+  const std::vector<Eigen::Vector3f>& plant_points =
+      options.crop_to_row_length ? in_row : all_plant_points;
   result.quality.points_plants = plant_points.size();
   if (plant_points.size() < options.min_plant_points)
     return failed(std::move(result), TraitsStatus::kNoPlants,

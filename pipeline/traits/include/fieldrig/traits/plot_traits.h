@@ -60,6 +60,9 @@ struct TraitsOptions {
   double ground_tilt_deg = 10.0;  // the paper's tilted plane about the base-ground edge
   // Slicing (equation 15): n = ceil(2 * row length / intra-row spacing) unless slices > 0.
   double row_length_m = 1.5;
+  // Only plant points within ±row_length_m / 2 of the plot's location (y = 0) are the plot's
+  // (off by default until it is measured on a field whose truth is what the rig can see).
+  bool crop_to_row_length = false;
   double intra_row_spacing_m = 0.15;
   int slices = 0;
   double min_row_extent_m = 0.05;  // shorter plants-only extent along y is "one slice only"
@@ -122,6 +125,7 @@ struct TraitsQuality {
   std::size_t points_ground = 0;         // below the plate's ground plane (+ margin)
   std::size_t points_ground_tilted = 0;  // below the 10-degree tilted planes only
   std::size_t points_plants = 0;
+  std::size_t points_beyond_row = 0;  // plant points beyond ±row_length_m / 2 (crop_to_row_length)
   std::size_t points_outside_box = 0;
   double icp_fitness_coarse = -1.0;  // mean squared correspondence distance, m^2 (-1: not run)
   double icp_fitness_fine = -1.0;
