@@ -60,8 +60,9 @@ void addSceneOptions(CLI::App& command, SceneArgs& scene) {
   scene.stage_option =
       command
           .add_option("--stage", scene.stages,
-                      "Growth stage early|mid|mature, or a comma-separated list splitting the "
-                      "plots in blocks (mesh renderer; selects it when --renderer is not given)")
+                      "Growth stage early|mid|mature (mesh default: mid), or a comma-separated "
+                      "list splitting the plots in blocks (mesh renderer; selects it when "
+                      "--renderer is not given)")
           ->delimiter(',')
           ->check(CLI::IsMember({"early", "mid", "mature"}));
   command.add_flag("--no-truth-maps", scene.no_truth_maps,

@@ -183,9 +183,15 @@ Hit hitOf(const RTCRayHit16& packet, int lane) {
   return h;
 }
 
+struct EdgeKey {
+  unsigned geom;
+  float t;
+};
+
 struct RenderScratch {
   std::vector<Eigen::Vector3f> directions;
   std::vector<Hit> centres;
+  std::vector<EdgeKey> keys;
 };
 
 void traceRays(RTCScene scene, RTCIntersectContext& context, RTCRayHit16& packet,
@@ -330,6 +336,9 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
   // one surface).
   std::vector<Hit>& centres = scratch.centres;
   centres.resize(static_cast<std::size_t>(width) * height);
+  // What the edge test reads of every pixel, packed (8 bytes, not a whole hit).
+  std::vector<EdgeKey>& keys = scratch.keys;
+  keys.resize(centres.size());
   cv::parallel_for_(cv::Range(0, tiles_y), [&](const cv::Range& range) {
     const FlushDenormals flush;
     RTCIntersectContext context;
@@ -352,9 +361,11 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
           ++count;
         }
         traceRays(scene, context, packet, valid, origin, dirs.data(), count);
-        for (int lane = 0; lane < count; ++lane)
-          centres[static_cast<std::size_t>(index[static_cast<std::size_t>(lane)])] =
-              hitOf(packet, lane);
+        for (int lane = 0; lane < count; ++lane) {
+          const auto i = static_cast<std::size_t>(index[static_cast<std::size_t>(lane)]);
+          centres[i] = hitOf(packet, lane);
+          keys[i] = {centres[i].geom, centres[i].t};
+        }
       }
     }
   });
@@ -368,6 +379,7 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     RTCIntersectContext shadow_context;
     rtcInitIntersectContext(&shadow_context);
+    shadow_context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // parallel rays from one tile
     alignas(64) RTCRayHit16 packet;
     alignas(64) RTCRay16 shadow;
     std::array<int, kPacket> valid{};
@@ -378,13 +390,13 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
     std::array<Eigen::Vector3f, kPacket> colour;
     std::array<bool, kPacket> edge{};
     auto isEdge = [&](int col, int row) {
-      const Hit& c = centres[static_cast<std::size_t>(row) * width + col];
+      const EdgeKey& c = keys[static_cast<std::size_t>(row) * width + col];
       // The four direct neighbours: a boundary through the pixel shows in one of them.
       constexpr std::array<std::array<int, 2>, 4> kNeighbours{{{-1, 0}, {1, 0}, {0, -1}, {0, 1}}};
       for (const auto& [dx, dy] : kNeighbours) {
         const int u = std::clamp(col + dx, 0, width - 1);
         const int v = std::clamp(row + dy, 0, height - 1);
-        const Hit& n = centres[static_cast<std::size_t>(v) * width + u];
+        const EdgeKey& n = keys[static_cast<std::size_t>(v) * width + u];
         if (n.geom != c.geom)
           return true;
         if (c.geom != RTC_INVALID_GEOMETRY_ID && std::abs(n.t - c.t) > 0.04F * c.t)
