@@ -18,6 +18,8 @@ packages=(
   # The feature pipeline: OpenCV with contrib (ximgproc's WLS filter), PCL with Qhull, Eigen.
   # Debian's PCL pulls VTK, whose CMake config wants MPI's C target.
   libopencv-dev libopencv-contrib-dev libpcl-dev libeigen3-dev mpi-default-dev
+  # The mesh renderer of synthetic fields (sim/mesh_render): Intel Embree 3 ray tracing.
+  libembree-dev
   # stem-ui's browser test drives Debian's headless Chromium (Playwright comes from npm).
   chromium
   # fieldrigd: sd_notify (READY, STATUS, WATCHDOG) from libsystemd; the systemd tests run

@@ -13,6 +13,19 @@ namespace {
 namespace fs = std::filesystem;
 }  // namespace
 
+PlotSeries fieldPlotSeries(const FieldSpec& spec, int plots) {
+  PlotSeries series;
+  series.count = plots;
+  series.seed = spec.seed;
+  series.height_min_m = spec.height_min_m;
+  series.height_max_m = spec.height_max_m;
+  series.renderer = spec.renderer;
+  series.stages = spec.stages;
+  series.stage_heights = spec.stage_heights;
+  series.truth_maps = spec.truth_maps;
+  return series;
+}
+
 core::Result<FieldFiles> writeSyntheticField(
     const fs::path& dir, const FieldSpec& spec,
     const std::function<void(const RecordedPlot&)>& progress) {
@@ -21,6 +34,8 @@ core::Result<FieldFiles> writeSyntheticField(
                        std::to_string(spec.rows) + " rows, " + std::to_string(spec.plots) +
                        " plots)"};
   }
+  if (auto error = validatePlotSeries(fieldPlotSeries(spec, spec.plots)))
+    return core::Error{"synthetic field: " + *error};
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec)
@@ -85,11 +100,7 @@ core::Result<FieldFiles> writeSyntheticField(
   if (auto saved = kept.save(files.map); !saved)
     return saved.error();
 
-  PlotSeries series;
-  series.count = static_cast<int>(order.size());
-  series.seed = spec.seed;
-  series.height_min_m = spec.height_min_m;
-  series.height_max_m = spec.height_max_m;
+  const PlotSeries series = fieldPlotSeries(spec, static_cast<int>(order.size()));
   auto recorded = recordSyntheticPlots(files.session, files.calibration, series, order, progress);
   if (!recorded)
     return recorded.error();

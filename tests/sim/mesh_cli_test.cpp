@@ -1,0 +1,80 @@
+// `fieldrig sim plots` and `fieldrig simulate` with the mesh renderer, through the built binary:
+// --stage alone selects it and its summary says so; the frames get their truth maps unless
+// --no-truth-maps; options that do not fit the renderer are refused before anything is written,
+// naming the flag.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "support/cli_run.h"
+#include "support/temp_dir.h"
+
+namespace fieldrig {
+namespace {
+
+namespace fs = std::filesystem;
+using testing_support::runFieldrig;
+using testing_support::ScopedTempDir;
+
+std::size_t countFiles(const fs::path& dir, const std::string& suffix) {
+  std::size_t count = 0;
+  for (const auto& entry : fs::directory_iterator(dir))
+    count += entry.path().filename().string().ends_with(suffix) ? 1 : 0;
+  return count;
+}
+
+TEST(MeshCli, StageAloneSelectsTheMeshRendererAndTruthMapsCanBeLeftOut) {
+  ScopedTempDir dir("mesh_cli_plots");
+  const fs::path session = dir / "session";
+  const auto run = runFieldrig({"sim", "plots", "--out", session.string(), "--count", "1",
+                                "--stage", "early", "--no-truth-maps"},
+                               dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  ASSERT_EQ(run.out_lines.size(), 1U);
+  const auto summary = nlohmann::json::parse(run.out_lines[0]);
+  EXPECT_EQ(summary.at("renderer"), "mesh");
+  EXPECT_EQ(summary.at("stages"), nlohmann::json::array({"early"}));
+  EXPECT_EQ(summary.at("plots"), 1);
+  EXPECT_EQ(countFiles(session / "frames", ".pgm"), 6U);
+  EXPECT_EQ(countFiles(session / "frames", ".depth.pfm"), 0U);
+  const auto truth = nlohmann::json::parse(testing_support::readWholeFile(session / "truth.jsonl"));
+  EXPECT_EQ(truth.at("renderer"), "mesh");
+  EXPECT_EQ(truth.at("stage"), "early");
+  EXPECT_TRUE(truth.at("truth_maps").empty());
+  // The calibrated rig: distorted lenses.
+  EXPECT_NE(
+      testing_support::readWholeFile(session / "calib" / "bottom" / "intrinsics.yml").find("-1.18"),
+      std::string::npos);
+}
+
+TEST(MeshCli, OptionsThatDoNotFitTheRendererAreRefusedBeforeAnythingIsWritten) {
+  ScopedTempDir dir("mesh_cli_refusals");
+  const std::string out = (dir / "out").string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"sim", "plots", "--out", out, "--stage", "late"}, "--stage"},
+      {{"sim", "plots", "--out", out, "--renderer", "raster"}, "--renderer"},
+      {{"sim", "plots", "--out", out, "--renderer", "splat", "--stage", "mid"}, "--stage"},
+      {{"sim", "plots", "--out", out, "--no-truth-maps"}, "--no-truth-maps"},
+      {{"sim", "plots", "--out", out, "--height-max", "3.5"}, "--renderer mesh"},
+      {{"sim", "plots", "--out", out, "--renderer", "mesh", "--height-max", "9"}, "--height-max"},
+      {{"sim", "plots", "--out", out, "--count", "2", "--stage", "early,mid,mature"}, "stages"},
+      {{"simulate", "--out", out, "--plots", "2", "--stage", "early,mid,mature"}, "stages"},
+      {{"simulate", "--out", out, "--renderer", "splat", "--stage", "mature"}, "--stage"},
+  };
+  for (const auto& [args, named] : cases) {
+    std::string joined;
+    for (const auto& a : args)
+      joined += a + " ";
+    SCOPED_TRACE(joined);
+    const auto run = runFieldrig(args, dir.path());
+    EXPECT_EQ(run.exit_code, 2) << run.err;
+    EXPECT_NE(run.err.find(named), std::string::npos) << run.err;
+    EXPECT_FALSE(fs::exists(out)) << "something was written";
+  }
+}
+
+}  // namespace
+}  // namespace fieldrig
