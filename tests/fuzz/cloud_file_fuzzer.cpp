@@ -6,6 +6,7 @@
 // std::bad_alloc this reader was fixed for): an error starts with the file's path; a cloud that
 // loads holds no more points than the file has bytes (every point takes at least one byte in
 // every format), and reading the same file again gives the same points.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -49,13 +50,14 @@ bool samePoints(const std::vector<Eigen::Vector3f>& a, const std::vector<Eigen::
 // `&cloud[0]`), undefined behaviour that UBSan stops at. Such inputs are skipped until
 // cloud_io.cpp answers them before PCL's conversion; delete this when it does.
 bool plyWithoutVertices(std::string_view data) {
-  const std::size_t end = data.find("end_header");
-  const std::string_view head = data.substr(0, end);
-  for (std::size_t at = head.find("element vertex "); at != std::string_view::npos;
-       at = head.find("element vertex ", at + 1)) {
-    const char next = at + 15 < head.size() ? head[at + 15] : '0';
-    if (next >= '1' && next <= '9')
+  const std::string_view head = data.substr(0, data.find("end_header"));
+  for (std::size_t at = 0; at < head.size();) {
+    const std::size_t end = std::min(head.find('\n', at), head.size());
+    const std::string_view line = head.substr(at, end - at);
+    if (startsWith(line, "element vertex ") && line.size() > 15 && line[15] >= '1' &&
+        line[15] <= '9')
       return false;
+    at = end + 1;
   }
   return true;
 }
