@@ -13,6 +13,7 @@
 #include <map>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "support/temp_dir.h"
@@ -505,6 +506,19 @@ TEST(ConfigText, ControlCharactersAreRefusedNamingTheLine) {
       << escape.error().message;
   // Tabs in comments and CRLF line ends are text.
   EXPECT_TRUE(parseConfig("# a\tcomment\r\nlog: {level: info}\r\n", "inline", "/srv").ok());
+}
+
+// Found by the traits options fuzzer: yaml-cpp 0.7's LoadAll never returned from a ',' outside a
+// flow collection. Such text is a syntax error naming its line.
+TEST(ConfigText, AStrayCommaIsASyntaxErrorNamingTheLine) {
+  for (const auto& [text, line] : {std::pair<std::string, int>{",", 1}, {"- a\n,\n", 2}}) {
+    const core::Result<Config> config = parseConfig(text, "inline", "/srv");
+    ASSERT_FALSE(config.ok()) << text;
+    EXPECT_EQ(config.error().message,
+              "inline:" + std::to_string(line) +
+                  ": YAML syntax error: text outside any value (a stray ',')")
+        << text;
+  }
 }
 
 // --- (d) Defaults
