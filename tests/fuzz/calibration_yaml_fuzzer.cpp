@@ -89,6 +89,20 @@ void checkStereo(const StereoCalibration& c, const fs::path& scratch) {
 // the loaders compare the size with the one they expect. Inputs whose matrices declare more than
 // two digits of rows or cols, or sizes at all, are skipped until the loaders check the declared
 // size first; delete this when they do.
+// Known finding, reported with issue 17 and not fixed here: cv::FileStorage::open does not return
+// (10 s and more) on some damaged YAML with NUL and other control bytes in it ("---  dt: d\n
+// d\x05\0\0…"), so a damaged rig.yml hangs every program that loads the calibration. Inputs
+// with control characters other than tab and line breaks are skipped until the loaders refuse
+// them before OpenCV (as config/ does before yaml-cpp); delete this when they do.
+bool hasControlCharacters(std::string_view data) {
+  for (const char c : data) {
+    const auto byte = static_cast<unsigned char>(c);
+    if ((byte < 0x20 && c != '\t' && c != '\n' && c != '\r') || byte == 0x7f)
+      return true;
+  }
+  return false;
+}
+
 bool declaresHugeMatrix(std::string_view data) {
   if (data.find("sizes") != std::string_view::npos)
     return true;
@@ -163,7 +177,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t size) {
   static const fieldrig::fuzz::FuzzFolder folder("calibration_yaml");
   const std::string_view data(reinterpret_cast<const char*>(bytes), size);
-  if (declaresHugeMatrix(data))
+  if (declaresHugeMatrix(data) || hasControlCharacters(data))
     return 0;
   const fs::path& dir = folder.path();
   for (const char* head : kHeads) {
