@@ -16,6 +16,9 @@ std::string fractionText(std::int64_t nanos, int digits) {
   return std::string(buffer, static_cast<std::size_t>(digits) + 1);
 }
 
+constexpr int kFirstWholeYear = 1678;
+constexpr int kLastWholeYear = 2261;
+
 bool parseInt(std::string_view text, int& out) {
   // Digits only: from_chars would take a sign ("T-1:00:00").
   if (text.empty() || text.find_first_not_of("0123456789") != std::string_view::npos)
@@ -64,6 +67,10 @@ std::optional<UtcTime> parseIso8601(std::string_view text) {
   const year_month_day ymd{year{y}, month{static_cast<unsigned>(mo)},
                            day{static_cast<unsigned>(d)}};
   if (!ymd.ok() || h > 23 || mi > 59 || s > 60)
+    return std::nullopt;
+  // UtcTime counts int64 nanoseconds from 1970: 1677-09-21 to 2262-04-11. Whole years inside that
+  // span only, so that the sum below cannot overflow (a year like 1012 did, undefined behaviour).
+  if (y < kFirstWholeYear || y > kLastWholeYear)
     return std::nullopt;
   std::int64_t nanos = 0;
   const std::string_view rest = text.substr(19, text.size() - 20);

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
 
 namespace fieldrig::recording {
 namespace {
@@ -20,6 +24,29 @@ std::optional<T> optionalFrom(const Json& object, const char* key) {
   if (it == object.end() || it->is_null())
     return std::nullopt;
   return it->template get<T>();
+}
+
+// A whole number of type T, or an error naming the key. nlohmann's get<T>() converts a fraction or
+// a number beyond T with a plain cast: wrapped values, and undefined behaviour for a float such as
+// 1e300 (the session index fuzzer found it).
+template <typename T>
+T whole(const Json& value, const char* key) {
+  if (value.is_number_unsigned() && std::in_range<T>(value.get<std::uint64_t>()))
+    return static_cast<T>(value.get<std::uint64_t>());
+  if (value.is_number_integer() && !value.is_number_unsigned() &&
+      std::in_range<T>(value.get<std::int64_t>()))
+    return static_cast<T>(value.get<std::int64_t>());
+  throw std::invalid_argument(std::string("'") + key + "' is not a whole number in [" +
+                              std::to_string(std::numeric_limits<T>::min()) + ", " +
+                              std::to_string(std::numeric_limits<T>::max()) + "]");
+}
+
+template <typename T>
+std::optional<T> optionalWhole(const Json& object, const char* key) {
+  const auto it = object.find(key);
+  if (it == object.end() || it->is_null())
+    return std::nullopt;
+  return whole<T>(*it, key);
 }
 
 Json fixJson(const core::GpsFix& fix) {
@@ -57,9 +84,9 @@ core::GpsFix fixFrom(const Json& in) {
   fix.course_deg = optionalFrom<double>(in, "course_deg");
   fix.altitude_m = optionalFrom<double>(in, "altitude_m");
   fix.hdop = optionalFrom<double>(in, "hdop");
-  if (const std::optional<int> quality = optionalFrom<int>(in, "quality"))
+  if (const std::optional<int> quality = optionalWhole<int>(in, "quality"))
     fix.quality = static_cast<core::FixQuality>(*quality);
-  fix.satellites = optionalFrom<int>(in, "satellites");
+  fix.satellites = optionalWhole<int>(in, "satellites");
   fix.talker = in.value("talker", std::string());
   return fix;
 }
@@ -85,7 +112,7 @@ Json frameJson(const IndexedFrame& frame) {
 
 IndexedFrame frameFrom(const Json& in) {
   IndexedFrame frame;
-  frame.camera_index = in.at("camera").get<int>();
+  frame.camera_index = whole<int>(in.at("camera"), "camera");
   frame.camera_name = in.at("name").get<std::string>();
   if (!in.at("file").is_null()) {
     frame.file = in.at("file").get<std::string>();
@@ -95,20 +122,20 @@ IndexedFrame frameFrom(const Json& in) {
     if (file.is_absolute() || std::find(file.begin(), file.end(), "..") != file.end())
       throw std::invalid_argument("frame file '" + frame.file + "' is outside the session folder");
   }
-  frame.width = in.at("width").get<int>();
-  frame.height = in.at("height").get<int>();
+  frame.width = whole<int>(in.at("width"), "width");
+  frame.height = whole<int>(in.at("height"), "height");
   const std::optional<core::PixelFormat> format =
       core::parsePixelFormat(in.at("pixel_format").get<std::string>());
   if (!format)
     throw std::invalid_argument("unknown pixel_format '" +
                                 in.at("pixel_format").get<std::string>() + "'");
   frame.pixel_format = *format;
-  frame.file_bytes = in.at("file_bytes").get<std::uint64_t>();
-  frame.crc32 = in.at("crc32").get<std::uint32_t>();
-  frame.sequence = in.at("sequence").get<std::uint64_t>();
-  frame.device_timestamp_ns = in.at("device_ns").get<std::int64_t>();
-  frame.host_steady_ns = in.at("host_steady_ns").get<std::int64_t>();
-  frame.host_system_ns = in.at("host_system_ns").get<std::int64_t>();
+  frame.file_bytes = whole<std::uint64_t>(in.at("file_bytes"), "file_bytes");
+  frame.crc32 = whole<std::uint32_t>(in.at("crc32"), "crc32");
+  frame.sequence = whole<std::uint64_t>(in.at("sequence"), "sequence");
+  frame.device_timestamp_ns = whole<std::int64_t>(in.at("device_ns"), "device_ns");
+  frame.host_steady_ns = whole<std::int64_t>(in.at("host_steady_ns"), "host_steady_ns");
+  frame.host_system_ns = whole<std::int64_t>(in.at("host_system_ns"), "host_system_ns");
   const std::optional<FrameStatus> status = parseFrameStatus(in.at("status").get<std::string>());
   if (!status)
     throw std::invalid_argument("unknown frame status '" + in.at("status").get<std::string>() +
@@ -219,8 +246,8 @@ std::optional<IndexedSet> fromIndexLine(std::string_view line, std::string& erro
       return std::nullopt;
     }
     IndexedSet set;
-    set.set_index = in.at("set").get<std::uint64_t>();
-    set.trigger_id = in.at("trigger_id").get<std::uint64_t>();
+    set.set_index = whole<std::uint64_t>(in.at("set"), "set");
+    set.trigger_id = whole<std::uint64_t>(in.at("trigger_id"), "trigger_id");
     set.location_id = optionalFrom<std::string>(in, "location_id");
     set.trigger_time = timeFrom(in.at("trigger_time"), "trigger_time");
     if (in.contains("planned_time"))

@@ -46,9 +46,14 @@ std::string timeText(core::UtcTime t) {
 std::string dateText(core::UtcTime t) {
   using namespace std::chrono;
   const year_month_day ymd{floor<days>(t)};
-  char buffer[8];
-  std::snprintf(buffer, sizeof buffer, "%02u%02u%02d", static_cast<unsigned>(ymd.day()),
-                static_cast<unsigned>(ymd.month()), static_cast<int>(ymd.year()) % 100);
+  // The year of the century is never negative (a year before 0 would print "-5"), and the buffer
+  // holds what the types allow, not only valid dates: GCC cannot see the ranges under the
+  // sanitizers and rightly warns (-Wformat-truncation) about the 8 bytes this used to have.
+  const auto year_of_century =
+      static_cast<unsigned>((static_cast<int>(ymd.year()) % 100 + 100) % 100);
+  char buffer[16];
+  std::snprintf(buffer, sizeof buffer, "%02u%02u%02u", static_cast<unsigned>(ymd.day()),
+                static_cast<unsigned>(ymd.month()), year_of_century);
   return buffer;
 }
 

@@ -13,6 +13,7 @@
 #include <map>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "support/temp_dir.h"
@@ -492,6 +493,36 @@ TEST(ConfigPaths, ParsedTextResolvesAgainstTheGivenFolderAndEmptyStaysEmpty) {
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().message.rfind("inline:1: map: expected a text value, got a list", 0), 0U)
       << bad.error().message;
+}
+
+// Found by the config fuzzer: yaml-cpp 0.7 never returned from a NUL byte inside a flow map.
+// Control characters are refused before yaml-cpp sees the text, naming the line and the byte.
+TEST(ConfigText, ControlCharactersAreRefusedNamingTheLine) {
+  const std::string with_nul = std::string("pipeline:\n  matcher: {mode: sg") + '\0' + "bm}\n";
+  const core::Result<Config> nul = parseConfig(with_nul, "inline", "/srv/fieldrig");
+  ASSERT_FALSE(nul.ok());
+  EXPECT_EQ(nul.error().message,
+            "inline:2: a control character (0x00) in the text; YAML allows none but tab and line "
+            "breaks");
+  const core::Result<Config> escape = parseConfig("log: {level: \x1b[31m}\n", "inline", "/srv");
+  ASSERT_FALSE(escape.ok());
+  EXPECT_EQ(escape.error().message.rfind("inline:1: a control character (0x1b)", 0), 0U)
+      << escape.error().message;
+  // Tabs in comments and CRLF line ends are text.
+  EXPECT_TRUE(parseConfig("# a\tcomment\r\nlog: {level: info}\r\n", "inline", "/srv").ok());
+}
+
+// Found by the traits options fuzzer: yaml-cpp 0.7's LoadAll never returned from a ',' outside a
+// flow collection. Such text is a syntax error naming its line.
+TEST(ConfigText, AStrayCommaIsASyntaxErrorNamingTheLine) {
+  for (const auto& [text, line] : {std::pair<std::string, int>{",", 1}, {"- a\n,\n", 2}}) {
+    const core::Result<Config> config = parseConfig(text, "inline", "/srv");
+    ASSERT_FALSE(config.ok()) << text;
+    EXPECT_EQ(config.error().message,
+              "inline:" + std::to_string(line) +
+                  ": YAML syntax error: text outside any value (a stray ',')")
+        << text;
+  }
 }
 
 // --- (d) Defaults

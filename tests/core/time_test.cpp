@@ -36,6 +36,19 @@ TEST(TimeTest, RejectsMalformedIso) {
   EXPECT_FALSE(parseIso8601("2026-07-14T+1:00:00Z"));
 }
 
+// Found by the session index fuzzer: a year like 1012 overflowed the nanosecond count (UB).
+TEST(TimeTest, RejectsYearsOutsideWhatNanosecondsFrom1970Hold) {
+  EXPECT_FALSE(parseIso8601("1012-05-29T16:26:40.120456789Z"));
+  EXPECT_FALSE(parseIso8601("1677-12-31T23:59:59Z"));
+  EXPECT_FALSE(parseIso8601("2262-01-01T00:00:00Z"));
+  EXPECT_FALSE(parseIso8601("9999-12-31T23:59:59Z"));
+  for (const char* edge : {"1678-01-01T00:00:00.000000000Z", "2261-12-31T23:59:59.999999999Z"}) {
+    const auto parsed = parseIso8601(edge);
+    ASSERT_TRUE(parsed) << edge;
+    EXPECT_EQ(formatIso8601(*parsed, 9), edge);
+  }
+}
+
 TEST(TimeTest, TimeOfDay) {
   EXPECT_EQ(formatTimeOfDay(13h + 28min + 20s + 600ms, 2), "13:28:20.60");
 }

@@ -107,7 +107,10 @@ TEST(TriggerAccuracyTest, ReplayBridgesAShortGapInTheCaptureOnTime) {
     crossing = t;
   }
   for (std::string line; std::getline(all, line);) {
-    const gps::Sentence s = gps::NmeaParser::parseLine(line.substr(0, line.size() - 1));
+    // The sentence's views point into the text: it must outlive them (a temporary did not; ASan
+    // found the use after free).
+    const std::string text = line.substr(0, line.size() - 1);
+    const gps::Sentence s = gps::NmeaParser::parseLine(text);
     const auto fix = assembler.add(s, {});
     if (fix && fix->time > crossing - std::chrono::milliseconds{250} &&
         fix->time <= crossing + std::chrono::milliseconds{350}) {

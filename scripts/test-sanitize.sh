@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Builds fieldrig with AddressSanitizer and UndefinedBehaviorSanitizer (GCC, RelWithDebInfo) into
+# build-asan/ (or $FIELDRIG_BUILD_DIR) and runs every test there. Any sanitizer report fails the
+# test that caused it: ASan aborts on the first error, UB stops the program
+# (-fno-sanitize-recover), LeakSanitizer fails a program that leaks at exit.
+#
+# The few tests that cannot run under the sanitizers skip themselves, saying why
+# (tests/support/sanitizer.h); the benchmarks and the fuzz smoke runs are not part of this build
+# (the fuzzers bring their own sanitizers, and run in the README's build).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${FIELDRIG_BUILD_DIR:-$root/build-asan}
+FIELDRIG_SANITIZE=address,undefined FIELDRIG_BUILD_DIR="$build" "$root/scripts/build.sh"
+# Stack traces for UB reports; ASan's defaults otherwise (leak detection included).
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}"
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}"
+# Instrumented code runs 2-3 times slower: the per-test limit is three times the README build's.
+ctest --test-dir "$build" --output-on-failure --timeout 900 -j "$(nproc)"
