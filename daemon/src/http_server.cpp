@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <boost/asio/dispatch.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
@@ -80,13 +81,13 @@ class Connection : public std::enable_shared_from_this<Connection> {
       server_.connections.erase(*self_);
   }
 
-  // Registers the connection (under the server's mutex) and starts reading.
+  // Registers the connection (under the server's mutex) and starts reading on its strand.
   void start() {
     {
       std::lock_guard lock(server_.mutex);
       self_ = server_.connections.insert(server_.connections.end(), {weak_from_this(), {}});
     }
-    read();
+    asio::dispatch(stream_.get_executor(), [self = shared_from_this()] { self->read(); });
   }
 
   // From any thread: closes the socket on the connection's strand; the pending read or write
