@@ -632,6 +632,8 @@ void readMatcher(const Value& section, stereo::MatcherOptions& o) {
                                   {"hh4", cv::StereoSGBM::MODE_HH4},
                               })},
               {"match_colour", flag(o.match_colour)},
+              {"full_width", flag(o.full_width)},
+              {"min_texture", numberIn(o.min_texture, 0, stereo::kMaxMinTexture)},
           });
   // The library's own ranges (and those across keys), so the file and the command line agree.
   if (auto valid = stereo::validate(o); !valid)
@@ -678,6 +680,7 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
           {"icp_fine_distance_m", nonNegative(o.icp_fine_distance_m)},
           {"icp_iterations", integer(o.icp_iterations, 1)},
           {"max_ground_tilt_deg", numberIn(o.max_ground_tilt_deg, 0, 90)},
+          {"max_ground_shift_m", numberIn(o.max_ground_shift_m, 0, 10)},
           {"ground_margin_m", nonNegative(o.ground_margin_m)},
           {"ground_tilt_deg", numberIn(o.ground_tilt_deg, 0, 90, true)},
           {"row_length_m", positive(o.row_length_m)},

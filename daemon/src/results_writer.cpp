@@ -59,6 +59,15 @@ nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::Pl
   line["trigger_status"] = identity.trigger_status;
   line["cloud_points"] = result.cloud_points;
   line["partial"] = result.partial;
+  Json heads = Json::array();
+  for (const cloud::HeadStatus& head : result.heads) {
+    heads.push_back({{"name", head.name},
+                     {"ok", head.ok},
+                     {"points", head.points},
+                     {"valid_pixel_fraction", head.valid_pixel_fraction},
+                     {"matched_column_fraction", head.matched_column_fraction}});
+  }
+  line["heads"] = std::move(heads);
   Json traits_json = traits::traitsToJson(result.traits, /*with_slices=*/false);
   // Timings are how long this machine took, not what the plot is: they stay out of the results,
   // so that the same inputs give byte-identical files (benchmarks and the status report them).

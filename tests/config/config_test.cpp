@@ -89,6 +89,8 @@ void expectSame(const stereo::MatcherOptions& actual, const stereo::MatcherOptio
   EXPECT_FIELD(wls_sigma);
   EXPECT_FIELD(mode);
   EXPECT_FIELD(match_colour);
+  EXPECT_FIELD(full_width);
+  EXPECT_FIELD(min_texture);
 }
 
 void expectSame(const cloud::CloudOptions& actual, const cloud::CloudOptions& expected) {
@@ -119,6 +121,7 @@ void expectSame(const traits::TraitsOptions& actual, const traits::TraitsOptions
   EXPECT_FIELD(icp_fine_distance_m);
   EXPECT_FIELD(icp_iterations);
   EXPECT_FIELD(max_ground_tilt_deg);
+  EXPECT_FIELD(max_ground_shift_m);
   EXPECT_FIELD(ground_margin_m);
   EXPECT_FIELD(ground_tilt_deg);
   EXPECT_FIELD(row_length_m);
@@ -617,6 +620,8 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
       "    wls_sigma: 1.2\n"
       "    mode: hh4\n"
       "    match_colour: true\n"
+      "    full_width: false\n"
+      "    min_texture: 3.5\n"
       "outputs: {csv: false, geojson: false, jsonl: false}\n"
       "status: {enabled: false, address: 0.0.0.0, port: 9000}\n"
       "replay: {realtime: true}\n"
@@ -664,6 +669,8 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
   matcher.wls_sigma = 1.2;
   matcher.mode = cv::StereoSGBM::MODE_HH4;
   matcher.match_colour = true;
+  matcher.full_width = false;
+  matcher.min_texture = 3.5;
   cloud::CloudOptions cloud_options;
   cloud_options.scale = 0.25;
   cloud_options.min_depth_m = 0.3;

@@ -52,6 +52,17 @@ TEST(ProcessCli, SyntheticSessionGivesTraitsCloseToTruth) {
     const std::string plot = line.at("location").get<std::string>();
     SCOPED_TRACE(plot + ": " + line.dump());
     EXPECT_FALSE(line.at("partial").get<bool>());
+    // How much each head measured: full-width matching leaves at most the columns whose match
+    // lies outside the right image (the nearest leaves: ~100 of 812) and the backdrop's edges.
+    ASSERT_EQ(line.at("heads").size(), 3U);
+    for (const Json& head : line.at("heads")) {
+      EXPECT_TRUE(head.at("ok").get<bool>());
+      EXPECT_GT(head.at("matched_column_fraction").get<double>(), 0.9);
+      EXPECT_LE(head.at("matched_column_fraction").get<double>(), 1.0);
+      EXPECT_GT(head.at("valid_pixel_fraction").get<double>(), 0.3);
+      EXPECT_LE(head.at("valid_pixel_fraction").get<double>(),
+                head.at("matched_column_fraction").get<double>());
+    }
     const Json& traits = line.at("traits");
     ASSERT_EQ(traits.at("status"), "ok");
     const Json& expected = truth.at(plot);
@@ -106,6 +117,10 @@ TEST(ProcessCli, AMissingCameraGivesAFlaggedPartialPlotNotAFailure) {
   }
   EXPECT_TRUE(names_the_file) << line.dump();
   EXPECT_EQ(line.at("traits").at("status"), "ok") << "two heads still see the plot's base";
+  const Json& top = line.at("heads").at(2);
+  EXPECT_EQ(top.at("name"), "top");
+  EXPECT_FALSE(top.at("ok").get<bool>());
+  EXPECT_EQ(top.at("matched_column_fraction").get<double>(), 0.0);
 }
 
 TEST(ProcessCli, ResumesSkipsWhatIsDoneRedoesWithForceAndSplitsIntoShards) {

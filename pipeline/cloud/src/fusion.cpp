@@ -75,6 +75,19 @@ std::size_t appendReprojected(const cv::Mat& disparity, const cv::Mat& left_bgr,
   return out.size() - before;
 }
 
+void measureCoverage(const cv::Mat& disparity, HeadStatus& status) {
+  CV_Assert(disparity.type() == CV_32F);
+  if (disparity.empty())
+    return;
+  const cv::Mat valid = disparity >= 0;
+  status.valid_pixel_fraction =
+      static_cast<double>(cv::countNonZero(valid)) / static_cast<double>(disparity.total());
+  cv::Mat column_max;
+  cv::reduce(valid, column_max, 0, cv::REDUCE_MAX);
+  status.matched_column_fraction =
+      static_cast<double>(cv::countNonZero(column_max)) / static_cast<double>(disparity.cols);
+}
+
 std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump) {
   CV_Assert(disparity.type() == CV_32F);
   // Neighbourhood maximum and minimum by grey dilation and erosion; invalid pixels must not
@@ -140,6 +153,7 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
         status.problem = output.error().message;
         return;
       }
+      measureCoverage(output->disparity, status);
       if (options_.edge_max_jump_px > 0)
         status.edge_pixels = dropDepthEdges(output->disparity, options_.edge_max_jump_px);
       status.points = appendReprojected(

@@ -24,6 +24,7 @@ PlotResult PlotProcessor::process(const std::vector<cloud::HeadFrames>& heads,
     if (!head.ok)
       result.problems.push_back("head " + head.name + " left out: " + head.problem);
   }
+  result.heads = fused.heads;
   result.cloud_points = fused.cloud.size();
   std::vector<Eigen::Vector3f> points;
   points.reserve(fused.cloud.size());

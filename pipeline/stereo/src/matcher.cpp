@@ -107,6 +107,8 @@ core::Result<void> validate(const MatcherOptions& options, OptionNames names) {
     return outside("wls_lambda", options.wls_lambda, "[0, ...), finite");
   if (!(options.wls_sigma > 0 && std::isfinite(options.wls_sigma)))
     return outside("wls_sigma", options.wls_sigma, "(0, ...), finite");
+  if (!(options.min_texture >= 0 && options.min_texture <= kMaxMinTexture))
+    return outside("min_texture", options.min_texture, range(0, kMaxMinTexture));
   if (options.mode != cv::StereoSGBM::MODE_SGBM && options.mode != cv::StereoSGBM::MODE_HH &&
       options.mode != cv::StereoSGBM::MODE_SGBM_3WAY && options.mode != cv::StereoSGBM::MODE_HH4) {
     return outside("mode", options.mode, "(sgbm, hh, sgbm_3way or hh4)");
@@ -186,8 +188,21 @@ DisparityMatcher::DisparityMatcher(const MatcherOptions& options) : options_(opt
 cv::Mat DisparityMatcher::compute(const cv::Mat& left, const cv::Mat& right,
                                   MatchTimings* timings) {
   CV_Assert(left.size() == right.size() && !left.empty());
-  const cv::Mat left_in = toChannels(left, options_.match_colour);
-  const cv::Mat right_in = toChannels(right, options_.match_colour);
+  cv::Mat left_in = toChannels(left, options_.match_colour);
+  cv::Mat right_in = toChannels(right, options_.match_colour);
+  cv::Mat guide = left;  // WLS's edge-aware guide: the left view as given
+  // Full width: the left view's unmatched band (SGBM's [0, maxD)) moves into padding on the left;
+  // the right view's (the right matcher's last maxD columns) into padding on the right.
+  const int band = std::max(options_.min_disparity + options_.num_disparities, 0);
+  const int pad_left = options_.full_width ? band : 0;
+  const int pad_right = options_.full_width && right_matcher_ ? band : 0;
+  if (pad_left > 0 || pad_right > 0) {
+    for (cv::Mat* image : {&left_in, &right_in, &guide}) {
+      cv::Mat padded;
+      cv::copyMakeBorder(*image, padded, 0, 0, pad_left, pad_right, cv::BORDER_REPLICATE);
+      *image = padded;
+    }
+  }
   auto start = Clock::now();
   cv::Mat left_fixed;
   cv::Mat right_fixed;
@@ -201,7 +216,7 @@ cv::Mat DisparityMatcher::compute(const cv::Mat& left, const cv::Mat& right,
   cv::Mat disparity;
   if (wls_) {
     cv::Mat filtered;
-    wls_->filter(left_fixed, left, filtered, right_fixed);
+    wls_->filter(left_fixed, guide, filtered, right_fixed);
     disparity = toFloatDisparity(filtered, options_.min_disparity);
   } else {
     disparity = toFloatDisparity(left_fixed, options_.min_disparity);
@@ -209,9 +224,44 @@ cv::Mat DisparityMatcher::compute(const cv::Mat& left, const cv::Mat& right,
       leftRightCheck(disparity, rightViewToFloat(right_fixed, options_), options_.lr_max_diff);
     }
   }
+  if (pad_left > 0 || pad_right > 0) {
+    disparity = disparity(cv::Rect(pad_left, 0, left.cols, left.rows)).clone();
+    // A match in the padding is a match with nothing: the right camera does not see that pixel.
+    for (int y = 0; y < disparity.rows; ++y) {
+      float* row = disparity.ptr<float>(y);
+      for (int x = 0; x < disparity.cols; ++x) {
+        if (row[x] >= 0 && static_cast<float>(x) - row[x] < 0.0f)
+          row[x] = kInvalidDisparity;
+      }
+    }
+  }
+  if (options_.min_texture > 0)
+    dropTexturelessPixels(disparity, left, options_.block_size + 2, options_.min_texture);
   if (timings)
     timings->filter_ms = core::millisecondsSince(start);
   return disparity;
+}
+
+void dropTexturelessPixels(cv::Mat& disparity, const cv::Mat& image, int window, double min_std) {
+  CV_Assert(disparity.type() == CV_32F && disparity.size() == image.size());
+  cv::Mat grey;
+  toChannels(image, false).convertTo(grey, CV_32F);
+  cv::Mat mean;
+  cv::Mat mean_of_squares;
+  const cv::Size box(window, window);
+  cv::boxFilter(grey, mean, CV_32F, box, cv::Point(-1, -1), true, cv::BORDER_REFLECT);
+  cv::boxFilter(grey.mul(grey), mean_of_squares, CV_32F, box, cv::Point(-1, -1), true,
+                cv::BORDER_REFLECT);
+  const float min_variance = static_cast<float>(min_std * min_std);
+  for (int y = 0; y < disparity.rows; ++y) {
+    float* row = disparity.ptr<float>(y);
+    const float* m = mean.ptr<float>(y);
+    const float* m2 = mean_of_squares.ptr<float>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (m2[x] - m[x] * m[x] < min_variance)
+        row[x] = kInvalidDisparity;
+    }
+  }
 }
 
 cv::Mat computeDefaultSgbm(const cv::Mat& left, const cv::Mat& right, int num_disparities) {

@@ -122,6 +122,7 @@ std::optional<OptionsProblem> TraitsOptions::validate() const {
       outOfRange("icp_fine_distance_m", icp_fine_distance_m, 0, 10),
       outOfRange("icp_iterations", icp_iterations, 1, 1000),
       outOfRange("max_ground_tilt_deg", max_ground_tilt_deg, 0, 90),
+      outOfRange("max_ground_shift_m", max_ground_shift_m, 0, 10),
       outOfRange("ground_margin_m", ground_margin_m, 0, 1),
       outOfRange("ground_tilt_deg", ground_tilt_deg, 0, 90, true),
       outOfRange("row_length_m", row_length_m, 0.01, 100),
@@ -474,10 +475,22 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
                       std::string(fit.converged ? "tilted the ground by " +
                                                       std::to_string(fit.tilt_deg) + " degrees"
                                                 : "did not converge"));
-  const Eigen::Matrix3d r = fit.transform.block<3, 3>(0, 0);
-  const Eigen::Vector3d t = fit.transform.block<3, 1>(0, 3);
-  const Eigen::Vector3d edge_centre =
-      r * Eigen::Vector3d(pose.ground_x, 0.5 * (y_lo + y_hi), pose.base_z) + t;
+  const Eigen::Vector3d data_edge_centre(pose.ground_x, 0.5 * (y_lo + y_hi), pose.base_z);
+  Eigen::Matrix4d plate_transform = fit.transform;
+  // Once the plate's soil strip has crept beyond the fine stage's reach, only its plant strip has
+  // correspondences, and it slides up the stems (14 cm seen on a rendered plot). The data's
+  // ground layer is then the better ground.
+  const double ground_shift = (plate_transform.block<3, 3>(0, 0) * data_edge_centre +
+                               plate_transform.block<3, 1>(0, 3) - data_edge_centre)
+                                  .x();
+  q.icp_ground_shift_m = ground_shift;
+  if (std::abs(ground_shift) > options.max_ground_shift_m) {
+    plate_transform.setIdentity();
+    q.ground_from_data_pose = true;
+  }
+  const Eigen::Matrix3d r = plate_transform.block<3, 3>(0, 0);
+  const Eigen::Vector3d t = plate_transform.block<3, 1>(0, 3);
+  const Eigen::Vector3d edge_centre = r * data_edge_centre + t;
   const Eigen::Vector3d normal = r * Eigen::Vector3d::UnitX();
   const Eigen::Vector3d across = r * Eigen::Vector3d::UnitZ();
   q.base_edge_centre = edge_centre;
@@ -513,6 +526,8 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
   traits.quality.icp_fitness_fine = q.icp_fitness_fine;
   traits.quality.icp_converged = q.icp_converged;
   traits.quality.icp_fell_back = q.icp_fell_back;
+  traits.quality.icp_ground_shift_m = q.icp_ground_shift_m;
+  traits.quality.ground_from_data_pose = q.ground_from_data_pose;
   traits.quality.ground_tilt_deg = q.ground_tilt_deg;
   traits.quality.base_edge_centre = q.base_edge_centre;
   traits.timings.filter_ms = result.timings.filter_ms;

@@ -76,6 +76,28 @@ TEST(TraitsTruth, TiltedGroundIsFoundByTheRegistration) {
   EXPECT_NEAR(r.height_m, plotTruth(plot, TraitsOptions{}).definitions.height_m, 0.03);
 }
 
+// A plate registration that moves the ground level beyond max_ground_shift_m is not used: the
+// data's densest low layer is the ground, and the result says so. With the guard at 0 any shift
+// trips it; with the default the registration's small correction stands.
+TEST(TraitsTruth, ARegistrationMovingTheGroundTooFarGivesWayToTheDataLayer) {
+  const sim::PlotCloud plot = sim::generatePlot(testSpec(1.5, 0.003, 25));
+  const TraitsResult registered = computeTraits(plot.points, InputFrame::kPlot, TraitsOptions{});
+  ASSERT_EQ(registered.status, TraitsStatus::kOk) << registered.message;
+  EXPECT_FALSE(registered.quality.ground_from_data_pose);
+  EXPECT_LT(std::abs(registered.quality.icp_ground_shift_m), TraitsOptions{}.max_ground_shift_m);
+  ASSERT_NE(registered.quality.icp_ground_shift_m, 0.0) << "nothing for the guard to refuse";
+  TraitsOptions strict;
+  strict.max_ground_shift_m = 0.0;
+  const TraitsResult from_data = computeTraits(plot.points, InputFrame::kPlot, strict);
+  ASSERT_EQ(from_data.status, TraitsStatus::kOk) << from_data.message;
+  EXPECT_TRUE(from_data.quality.ground_from_data_pose);
+  EXPECT_NEAR(from_data.quality.base_edge_centre.x(),
+              registered.quality.base_edge_centre.x() - registered.quality.icp_ground_shift_m,
+              1e-6);
+  // The data's layer is a 1 cm histogram bin: the ground within about a centimetre either way.
+  EXPECT_NEAR(from_data.quality.base_edge_centre.x(), plot.truth.ground_x_m, 0.015);
+}
+
 // Paper claim 1: the weighted median of per-slice maxima ignores a single abnormal tall plant.
 TEST(TraitsTruth, WeightedMedianIgnoresASingleTallPlant) {
   sim::PlotSpec spec = testSpec(1.8, 0.003, 25);

@@ -33,6 +33,11 @@ struct HeadStatus {
   std::string problem;  // why the head was left out, when not ok
   std::size_t points = 0;
   std::size_t edge_pixels = 0;  // dropped as depth edges (dropDepthEdges)
+  // How much of the left image stereo measured (before the edge filter and the depth crop): the
+  // fraction of pixels with a disparity, and of columns with at least one — a head that matched
+  // only part of the row shows here, not as a narrower plant.
+  double valid_pixel_fraction = 0;
+  double matched_column_fraction = 0;
   stereo::HeadTimings timings;
   double reproject_ms = 0;  // reprojection, transform into the plot frame, crop, colour
 };
@@ -50,6 +55,9 @@ struct FusionResult {
 std::size_t appendReprojected(const cv::Mat& disparity, const cv::Mat& left_bgr, const cv::Mat& Q,
                               const cv::Matx44d& to_output, double min_z, double max_z, Cloud& out,
                               double* reproject_ms = nullptr);
+
+// Sets `status`'s valid_pixel_fraction and matched_column_fraction from `disparity` (CV_32F).
+void measureCoverage(const cv::Mat& disparity, HeadStatus& status);
 
 // Marks as invalid (stereo::kInvalidDisparity) every pixel of `disparity` (CV_32F) whose valid
 // 3×3 neighbours, itself included, differ by more than `max_jump` pixels of disparity. Returns how

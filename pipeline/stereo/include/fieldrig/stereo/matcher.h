@@ -37,6 +37,16 @@ struct MatcherOptions {
   double wls_sigma = 1.5;
   int mode = cv::StereoSGBM::MODE_SGBM_3WAY;
   bool match_colour = false;  // true: SGBM on BGR (3 channels), false: on grey
+  // SGBM leaves the leftmost min_disparity + num_disparities columns of the left view without
+  // disparity (a sixth of an 812-pixel image at 128), though most of them see what the right
+  // camera sees too. true: the pair is padded by that many columns before matching, and a pixel
+  // keeps its disparity only when its match lies inside the right image.
+  bool full_width = true;
+  // Pixels whose grey level varies less than this (standard deviation over a window of
+  // block_size + 2, in 8-bit grey levels) have nothing to match on — sky, saturated highlights —
+  // and SGBM's smoothness term fills them from their neighbours: they are made invalid. 0 keeps
+  // them.
+  double min_texture = 0.0;
 };
 
 // The ranges validate() enforces, each with its reason:
@@ -51,6 +61,8 @@ inline constexpr int kMaxBlockSize = 31;
 inline constexpr int kMaxPenaltyPerPixel = 1000;
 // - pre_filter_cap: OpenCV's own limit (StereoBM's; SGBM keeps the clipped values in 8 bits).
 inline constexpr int kMaxPreFilterCap = 63;
+// - min_texture: a standard deviation of 8-bit grey levels cannot exceed 127.5.
+inline constexpr double kMaxMinTexture = 127.5;
 
 // How validate() names an option in its errors: the configuration key ("num_disparities") or the
 // `fieldrig disparity` flag ("--num-disparities").
@@ -100,6 +112,10 @@ cv::Mat computeDefaultSgbm(const cv::Mat& left, const cv::Mat& right, int num_di
 // Keeps pixels of `left_disparity` whose match in `right_disparity` (right view, positive
 // pixels, kInvalidDisparity = none) lies within `max_diff`; the others become invalid.
 void leftRightCheck(cv::Mat& left_disparity, const cv::Mat& right_disparity, float max_diff);
+
+// Makes invalid the pixels of `disparity` whose grey level in `image` (same size, grey or BGR)
+// has a standard deviation below `min_std` over a `window` × `window` neighbourhood.
+void dropTexturelessPixels(cv::Mat& disparity, const cv::Mat& image, int window, double min_std);
 
 // Fixed-point SGBM output (CV_16S, ×16) → float pixels with kInvalidDisparity below min_disparity.
 cv::Mat toFloatDisparity(const cv::Mat& fixed_point, int min_disparity);

@@ -53,8 +53,11 @@ struct TraitsOptions {
   double icp_fine_distance_m = 0.03;   // fine stage, so the plate cannot hang on leaves; 0: none
   int icp_iterations = 10;             // per stage
   double max_ground_tilt_deg = 15.0;   // a registration tilted further is rejected
-  double ground_margin_m = 0.01;       // points this close above the plate's ground go with it
-  double ground_tilt_deg = 10.0;       // the paper's tilted plane about the base-ground edge
+  // A registration that moves the ground level further than this from the data's lowest dense
+  // layer has slid up the plants: the data's layer is used instead (quality.ground_from_data_pose).
+  double max_ground_shift_m = 0.05;
+  double ground_margin_m = 0.01;  // points this close above the plate's ground go with it
+  double ground_tilt_deg = 10.0;  // the paper's tilted plane about the base-ground edge
   // Slicing (equation 15): n = ceil(2 * row length / intra-row spacing) unless slices > 0.
   double row_length_m = 1.5;
   double intra_row_spacing_m = 0.15;
@@ -125,6 +128,8 @@ struct TraitsQuality {
   bool icp_converged = false;
   bool icp_fell_back = false;    // the coarse stage tilted too far; fine stage from the data pose
   double ground_tilt_deg = 0.0;  // angle between the registered ground normal and x
+  double icp_ground_shift_m = 0.0;     // ground level, registered − data's lowest dense layer
+  bool ground_from_data_pose = false;  // the registration moved it too far (max_ground_shift_m)
   Eigen::Vector3d base_edge_centre = Eigen::Vector3d::Zero();
   int slices = 0;
   int occupied_slices = 0;
