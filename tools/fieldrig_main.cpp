@@ -1,30 +1,10 @@
 // fieldrig: the command-line tool. Parses flags and dispatches to a subcommand's run function.
 #include <CLI/CLI.hpp>
-#include <exception>
-#include <filesystem>
-#include <iostream>
-#include <new>
 #include <string>
 
+#include "commands/command_helpers.h"
 #include "commands/commands.h"
-#include "fieldrig/core/exception_message.h"
 #include "fieldrig/core/logging.h"
-
-namespace {
-
-// "fieldrig map generate": the subcommands that were parsed, for the one line that says what
-// failed.
-std::string commandName(const CLI::App& app) {
-  std::string name = "fieldrig";
-  const CLI::App* at = &app;
-  for (auto parsed = at->get_subcommands(); !parsed.empty(); parsed = at->get_subcommands()) {
-    at = parsed.front();
-    name += " " + at->get_name();
-  }
-  return name;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   using namespace fieldrig::tools;
@@ -52,16 +32,6 @@ int main(int argc, char** argv) {
   registerProcessCommand(app, exit_code);
   registerSimulateCommand(app, exit_code);
   registerEvaluateCommand(app, exit_code);
-  // The run functions are CLI11 callbacks, so whatever they let escape arrives here too.
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    // --help is a ParseError with exit code 0; every other one is an option that cannot be used.
-    return app.exit(error) == 0 ? kExitOk : kExitBadInput;
-  } catch (...) {
-    std::cerr << commandName(app)
-              << ": internal error: " << fieldrig::core::currentExceptionMessage() << '\n';
-    return kExitInternal;
-  }
-  return exit_code;
+  // The run functions are CLI11 callbacks, so whatever they let escape arrives there too.
+  return runCommandLine(app, "fieldrig", argc, argv, exit_code);
 }

@@ -91,8 +91,16 @@ int runMain(int argc, char** argv, bool& logging_ready) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
-    // --help is a ParseError with exit code 0; every other one is an option that cannot be used.
-    return app.exit(error) == 0 ? kExitOk : kExitBadInput;
+    // --help is a ParseError with exit code 0; every other one is an option that cannot be used,
+    // said on one line that names the command.
+    if (error.get_exit_code() == 0)
+      return app.exit(error);
+    std::string command = "fieldrigd";
+    if (!app.get_subcommands().empty())
+      command += " " + app.get_subcommands().front()->get_name();
+    std::cerr << command << ": " << error.what() << " (" << command
+              << " --help lists the options)\n";
+    return kExitBadInput;
   }
 
   if (!check_config.empty())

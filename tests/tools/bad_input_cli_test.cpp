@@ -204,6 +204,10 @@ std::vector<BadInputCase> pathCases() {
        "{dir}"},
       {"TraitsCloudDirectory", {"traits", "--cloud", "{dir}"}, "--cloud"},
       {"TraitsConfigDirectory", {"traits", "--cloud", "{cloud}", "--config", "{dir}"}, "--config"},
+      // stem-ui: a folder as the measurement file, a file as the calibration folder. Before, the
+      // page started and every save then failed with 500.
+      {"StemUiOutDirectory", {"stem-ui", "{session}", "--port", "0", "--out", "{dir}"}, "{dir}"},
+      {"StemUiCalibFile", {"stem-ui", "{session}", "--port", "0", "--calib", "{map}"}, "{map}"},
   };
 }
 

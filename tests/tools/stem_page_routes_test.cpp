@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <string>
 
 #include "stem_page/route_table.h"
 
@@ -32,7 +33,7 @@ class RouteTableTest : public ::testing::Test {
 
   HttpReply called(const std::string& what) {
     calls_.push_back(what);
-    return {http::status::ok, "text/plain", what, ""};
+    return {http::status::ok, "text/plain", what, {}};
   }
   HttpReply send(http::verb method, const std::string& target, const std::string& body = "") {
     return table_.dispatch(HttpRequest{method, target, body});
@@ -84,6 +85,23 @@ TEST_F(RouteTableTest, EveryWayOutOfTheTreeIsRefusedBeforeAHandlerRuns) {
     EXPECT_NE(error(reply).find("percent-encoding"), std::string::npos) << target;
   }
   EXPECT_TRUE(calls_.empty());
+}
+
+TEST(IsPlainName, TakesANameThatStaysInItsFolderOnly) {
+  for (const char* name : {"bottom", "head 2", "a.b", "..a", "%2e%2e"})
+    EXPECT_TRUE(isPlainName(name)) << name;
+  for (const std::string& name :
+       {std::string(), std::string("."), std::string(".."), std::string("../x"),
+        std::string("/etc"), std::string("a\\b"), std::string("a\0b", 3)})
+    EXPECT_FALSE(isPlainName(name)) << name;
+}
+
+// A session folder's name or a hand-edited CSV may hold bytes that are not UTF-8: the reply
+// carries a replacement character instead of failing (nlohmann::json throws on them by default).
+TEST(JsonReply, ReplacesBytesThatAreNotUtf8) {
+  const HttpReply reply = jsonReply({{"name", "plot\xff"}});
+  EXPECT_EQ(reply.status, http::status::ok);
+  EXPECT_EQ(Json::parse(reply.body).at("name"), "plot\xef\xbf\xbd");
 }
 
 }  // namespace

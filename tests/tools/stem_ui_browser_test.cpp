@@ -17,10 +17,10 @@
 #include <sstream>
 #include <thread>
 
-#include "fieldrig/recording/session_writer.h"
 #include "fieldrig/stem/measurement_log.h"
 #include "support/cli_run.h"
 #include "support/stem_campaign.h"
+#include "support/stem_session.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig {
@@ -29,37 +29,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kChromium = "/usr/bin/chromium";
-
-// Writes one FrameSet with the pair as bottom_left/bottom_right, raw BayerRG8 (a grey scene's
-// mosaic is the grey image itself).
-void writeSession(const fs::path& dir, const sim::RenderedStereoPair& pair,
-                  const fs::path& calibration_dir) {
-  recording::SessionInfo info;
-  info.calibration.push_back({"head_bottom", calibration_dir.string()});
-  recording::SessionWriter writer;
-  ASSERT_TRUE(writer.open(dir, info).ok());
-  recording::FrameSetRecord set;
-  set.trigger_id = 1;
-  set.location_id = "plot-0042";
-  set.trigger_time = core::UtcTime{} + std::chrono::hours{24 * 20000};
-  const cv::Mat* images[2] = {&pair.left, &pair.right};
-  const char* names[2] = {"bottom_left", "bottom_right"};
-  for (int camera = 0; camera < 2; ++camera) {
-    recording::FrameView frame;
-    frame.camera_index = camera;
-    frame.camera_name = names[camera];
-    frame.width = images[camera]->cols;
-    frame.height = images[camera]->rows;
-    frame.stride = images[camera]->cols;
-    frame.pixel_format = core::PixelFormat::kBayerRG8;
-    frame.pixels = std::span<const std::uint8_t>(images[camera]->data, images[camera]->total());
-    frame.sequence = 1;
-    set.frames.push_back(frame);
-  }
-  const recording::WriteOutcome outcome = writer.write(set);
-  ASSERT_TRUE(outcome.ok()) << outcome.message;
-  writer.close();
-}
 
 // The server as a child process; its first stdout line names the port.
 class ServerProcess {
@@ -119,7 +88,7 @@ TEST(StemUiBrowser, MeasuresSavesAndSummarizesInHeadlessChromium) {
   const sim::RenderedStereoPair pair = sim::renderCylinderPair(c.geometry, c.scene);
   ASSERT_TRUE(stereo::saveStereoCalibration(pair.calibration, dir / "calibration").ok());
   const fs::path session = dir / "session_2026-07-01";
-  writeSession(session, pair, dir / "calibration");
+  testing_support::writeStemSession(session, pair, dir / "calibration");
 
   ServerProcess server({"stem-ui", session.string(), "--port", "0"}, dir / "server.log");
   const std::string url = waitForUrl(dir / "server.log");

@@ -1,6 +1,7 @@
 // What the subcommands share beyond their exit codes: a subcommand added with the arguments its
 // options are bound to and the run function that sets the exit code, a command that only groups
-// subcommands, a failure reported on stderr, and the one JSON line most of them print.
+// subcommands, a failure reported on stderr, the one JSON line most of them print, and main()'s
+// parse-and-run that turns every failure into one line naming the command.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,6 +18,7 @@
 #include <utility>
 
 #include "commands/commands.h"
+#include "fieldrig/core/exception_message.h"
 
 namespace fieldrig::tools {
 
@@ -91,6 +93,41 @@ inline std::string openInputFile(const std::string& path, std::ifstream& in) {
   if (!in)
     return "cannot open '" + path + "'";
   return {};
+}
+
+// "fieldrig map generate": the program and the subcommands that were parsed, for the one line
+// that says what failed. (Not the app's name: CLI11 names an unnamed app after argv[0], a path.)
+inline std::string commandName(const CLI::App& app, const std::string& program) {
+  std::string name = program;
+  const CLI::App* at = &app;
+  for (auto parsed = at->get_subcommands(); !parsed.empty(); parsed = at->get_subcommands()) {
+    at = parsed.front();
+    name += " " + at->get_name();
+  }
+  return name;
+}
+
+// main(): parses the command line, whose subcommand callbacks run the command and set
+// `exit_code`, and gives the process's exit code. Whatever fails says so in one stderr line that
+// names the command: an option CLI11 refuses (exit 2; --help is exit 0), or an exception that
+// nothing else handled (exit 4).
+inline int runCommandLine(CLI::App& app, const std::string& program, int argc,
+                          const char* const* argv, const int& exit_code) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    if (error.get_exit_code() == 0)
+      return app.exit(error);
+    const std::string command = commandName(app, program);
+    std::cerr << command << ": " << error.what() << " (" << command
+              << " --help lists the options)\n";
+    return kExitBadInput;
+  } catch (...) {
+    std::cerr << commandName(app, program)
+              << ": internal error: " << core::currentExceptionMessage() << '\n';
+    return kExitInternal;
+  }
+  return exit_code;
 }
 
 // Prints `line` as one line of JSON on stdout and gives the exit code back.

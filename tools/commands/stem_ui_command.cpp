@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "commands/command_helpers.h"
-#include "stem_page/http_server.h"
+#include "fieldrig/daemon/http_server.h"
 #include "stem_page/stem_page.h"
 
 namespace fieldrig::tools {
@@ -36,13 +36,14 @@ int runStemUi(const StemUiArgs& args) {
     std::cerr << who << "--port: " << args.port << " is not a port\n";
     return kExitBadInput;
   }
-  auto server = stem_page::HttpServer::listen(address, static_cast<std::uint16_t>(args.port));
+  auto server = daemon::HttpServer::listen(address, static_cast<std::uint16_t>(args.port),
+                                           {.name = "fieldrig stem-ui"});
   if (!server)
     return fail(who, server.error().message, kExitRuntime);
   std::cout << who << "serving http://" << args.bind << ":" << (*server)->port() << "/"
             << std::endl;
-  (*server)->run(
-      [&page](const stem_page::HttpRequest& request) { return (*page)->handle(request); });
+  (*server)->run([&page](const daemon::HttpRequest& request) { return (*page)->handle(request); });
+  return kExitOk;
 }
 
 }  // namespace

@@ -43,8 +43,18 @@ bool isParameter(const std::string& segment) {
 
 }  // namespace
 
+bool isPlainName(std::string_view name) {
+  return !name.empty() && name != "." && name != ".." &&
+         name.find_first_of(std::string_view("/\\\0", 3)) == std::string_view::npos;
+}
+
 HttpReply jsonReply(const nlohmann::ordered_json& body, http::status status) {
-  return {status, "application/json", body.dump(), ""};
+  // Invalid UTF-8 (a session folder's name, a hand-edited CSV) is replaced, not thrown: a reply
+  // must not fail on one bad byte in one field.
+  return {status,
+          "application/json",
+          body.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace),
+          {}};
 }
 
 RouteTable::RouteTable(std::vector<Route> routes) {
@@ -72,8 +82,7 @@ HttpReply RouteTable::route(const HttpRequest& request) const {
     const std::optional<std::string> segment = percentDecode(raw);
     if (!segment)
       reject(http::status::bad_request, "malformed percent-encoding in the path");
-    if (*segment == ".." || *segment == "." || segment->find_first_of("/\\") != std::string::npos ||
-        segment->find('\0') != std::string::npos)
+    if (!isPlainName(*segment))
       reject(http::status::bad_request, "path traversal is not allowed: " + path);
     segments.push_back(*segment);
   }

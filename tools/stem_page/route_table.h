@@ -13,16 +13,25 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
-#include "stem_page/http_server.h"
+#include "fieldrig/daemon/http_server.h"
 
 namespace fieldrig::stem_page {
+
+using daemon::HttpReply;
+using daemon::HttpRequest;
 
 struct HttpError {
   boost::beast::http::status status;
   std::string message;
 };
+
+// A name that stays in the folder it is joined to: not empty, not "." or "..", and without a
+// slash, backslash or NUL. The route table holds every path segment of a request to it; handlers
+// hold to it every name from a request body that they join to a folder.
+bool isPlainName(std::string_view name);
 
 [[noreturn]] inline void reject(boost::beast::http::status status, const std::string& message) {
   throw HttpError{status, message};

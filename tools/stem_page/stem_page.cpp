@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 
@@ -73,6 +74,39 @@ const recording::IndexedFrame& frameOf(const recording::IndexedSet& set, const s
   }
   reject(http::status::not_found,
          "set " + std::to_string(set.set_index) + " has no camera '" + camera + "'");
+}
+
+// The head a request names, if the set has it: the name is joined to the calibration folder, so
+// only a head whose two cameras the set recorded, and whose name stays in that folder, is taken.
+const std::string& headOf(const recording::IndexedSet& set, const std::string& head) {
+  if (!isPlainName(head))
+    reject(http::status::bad_request, "field 'head': '" + head + "' is not a head name");
+  for (const std::string& known : headsOf(set)) {
+    if (known == head)
+      return head;
+  }
+  reject(http::status::not_found,
+         "set " + std::to_string(set.set_index) + " has no head '" + head + "'");
+}
+
+// A label is text a person typed: line breaks and tabs are kept (the CSV quotes them), other
+// control characters are refused, as is an empty label or one over 100 bytes.
+std::string labelOf(const Json& json) {
+  if (!json.contains("label") || !json["label"].is_string())
+    reject(http::status::bad_request, "field 'label': expected the stem's label (1-100 chars)");
+  std::string label = json["label"].get<std::string>();
+  if (label.empty() || label.size() > 100)
+    reject(http::status::bad_request, "field 'label': expected the stem's label (1-100 chars)");
+  for (const char c : label) {
+    const auto byte = static_cast<unsigned char>(c);
+    if ((byte < 0x20 && c != '\n' && c != '\r' && c != '\t') || byte == 0x7f) {
+      char code[8];
+      std::snprintf(code, sizeof code, "0x%02x", byte);
+      reject(http::status::bad_request,
+             std::string("field 'label': control character ") + code + " is not allowed");
+    }
+  }
+  return label;
 }
 
 cv::Mat greyFrame(const recording::SessionReader& reader, const recording::IndexedFrame& f) {
@@ -148,11 +182,15 @@ Route::Handler StemPage::locked(ApiHandler handler) {
 }
 
 HttpReply StemPage::page() {
-  return {http::status::ok, "text/html; charset=utf-8", std::string(pageHtml()), ""};
+  return {http::status::ok, "text/html; charset=utf-8", std::string(pageHtml()), {}};
 }
 
 core::Result<std::unique_ptr<StemPage>> StemPage::open(StemPageOptions options) {
   std::unique_ptr<StemPage> page(new StemPage(std::move(options)));
+  std::error_code ec;
+  if (const std::string& calib = page->options_.calib;
+      !calib.empty() && !fs::is_directory(calib, ec))
+    return core::Error{"calibration folder '" + calib + "': not a folder"};
   for (const std::string& dir : page->options_.sessions) {
     core::Result<recording::SessionReader> reader = recording::SessionReader::open(dir);
     if (!reader)
@@ -166,6 +204,10 @@ core::Result<std::unique_ptr<StemPage>> StemPage::open(StemPageOptions options) 
     session.reader = std::make_unique<recording::SessionReader>(std::move(*reader));
     session.csv = page->options_.out.empty() ? fs::path(dir) / "stem_measurements.csv"
                                              : fs::path(page->options_.out);
+    // A measurement file that cannot be read (a folder, a damaged row) is named now, not met as
+    // an error on every list and save.
+    if (auto records = stem::readMeasurementLog(session.csv); !records)
+      return records.error();
     page->sessions_.push_back(std::move(session));
   }
   return page;
@@ -215,6 +257,7 @@ stereo::StereoCalibration StemPage::calibration(const Session& s, const std::str
 
 const stem::StemMeasurer& StemPage::measurer(const Session& s, const recording::IndexedSet& set,
                                              const std::string& head) {
+  headOf(set, head);
   const std::string key = s.name + "/" + std::to_string(set.set_index) + "/" + head;
   for (auto it = measurers_.begin(); it != measurers_.end(); ++it) {
     if (it->first == key) {
@@ -294,10 +337,10 @@ HttpReply StemPage::frameImage(const PathParams& params, const HttpRequest&) {
     reject(http::status::not_found, "images are left.png and right.png");
   const core::CameraSide side =
       image == "left.png" ? core::CameraSide::kLeft : core::CameraSide::kRight;
-  const cv::Mat grey = greyFrame(*s.reader, frameOf(set, params.at("head"), side));
+  const cv::Mat grey = greyFrame(*s.reader, frameOf(set, headOf(set, params.at("head")), side));
   std::vector<std::uint8_t> png;
   cv::imencode(".png", grey, png, {cv::IMWRITE_PNG_COMPRESSION, 1});
-  return {http::status::ok, "image/png", std::string(png.begin(), png.end()), ""};
+  return {http::status::ok, "image/png", std::string(png.begin(), png.end()), {}};
 }
 
 HttpReply StemPage::measure(const PathParams& params, const HttpRequest& request) {
@@ -316,9 +359,7 @@ HttpReply StemPage::saveMeasurement(const PathParams& params, const HttpRequest&
   const Session& s = session(params);
   const Json json = parseBody(request.body);
   const MeasureRequest r = measureRequest(json);
-  if (!json.contains("label") || !json["label"].is_string() ||
-      json["label"].get<std::string>().empty() || json["label"].get<std::string>().size() > 100)
-    reject(http::status::bad_request, "field 'label': expected the stem's label (1-100 chars)");
+  const std::string label = labelOf(json);
   const recording::IndexedSet& set = setOf(*s.reader, s.name, r.set);
   const stem::StemMeasurement m =
       measurer(s, set, r.head).measure(r.points, stem::MeasureOptions{});
@@ -332,7 +373,7 @@ HttpReply StemPage::saveMeasurement(const PathParams& params, const HttpRequest&
   record.set_index = set.set_index;
   record.trigger_id = set.trigger_id;
   record.head = r.head;
-  record.stem_label = json["label"].get<std::string>();
+  record.stem_label = label;
   record.points = r.points;
   record.disparity_px = m.disparity_px;
   record.ncc = m.ncc;
@@ -362,9 +403,13 @@ HttpReply StemPage::exportCsv(const PathParams& params, const HttpRequest&) {
   const Session& s = session(params);
   std::string error;
   std::optional<std::string> content = core::readWholeFile(s.csv, error);
-  return {http::status::ok, "text/csv; charset=utf-8",
+  // No file yet is an empty log; a file that is there but cannot be read is not.
+  if (std::error_code ec; !content && fs::exists(s.csv, ec))
+    reject(http::status::internal_server_error, error);
+  return {http::status::ok,
+          "text/csv; charset=utf-8",
           content ? std::move(*content) : stem::csvHeader() + '\n',
-          "attachment; filename=\"stem_measurements.csv\""};
+          {{"Content-Disposition", "attachment; filename=\"stem_measurements.csv\""}}};
 }
 
 }  // namespace fieldrig::stem_page

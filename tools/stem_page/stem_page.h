@@ -26,7 +26,6 @@
 #include "fieldrig/core/result.h"
 #include "fieldrig/recording/session_reader.h"
 #include "fieldrig/stem/stem_measurer.h"
-#include "stem_page/http_server.h"
 #include "stem_page/route_table.h"
 
 namespace fieldrig::stem_page {

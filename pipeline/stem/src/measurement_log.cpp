@@ -5,8 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <sstream>
+#include <string_view>
 
 #include "fieldrig/core/durable_file.h"
 
@@ -34,31 +33,38 @@ std::string number(double value, int decimals) {
   return buffer;
 }
 
-bool splitCsvLine(const std::string& line, std::vector<std::string>& fields) {
-  fields.clear();
-  std::string field;
+// One CSV record (RFC 4180) from `text` at `pos`: its fields, with quoted fields holding commas,
+// doubled quotes and line breaks, as toCsvRow writes a label typed with a line break. Advances
+// `pos` past the record's line end and `line` by the physical lines it took. False for a quoted
+// field that the file ends inside.
+bool nextCsvRecord(std::string_view text, std::size_t& pos, int& line,
+                   std::vector<std::string>& fields) {
+  fields.assign(1, std::string());
   bool in_quotes = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
+  for (; pos < text.size(); ++pos) {
+    const char c = text[pos];
     if (in_quotes) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        field += '"';
-        ++i;
+      if (c == '"' && pos + 1 < text.size() && text[pos + 1] == '"') {
+        fields.back() += '"';
+        ++pos;
       } else if (c == '"') {
         in_quotes = false;
       } else {
-        field += c;
+        line += c == '\n' ? 1 : 0;
+        fields.back() += c;
       }
     } else if (c == '"') {
       in_quotes = true;
     } else if (c == ',') {
-      fields.push_back(field);
-      field.clear();
+      fields.emplace_back();
+    } else if (c == '\n') {
+      ++pos;
+      ++line;
+      return true;
     } else if (c != '\r') {
-      field += c;
+      fields.back() += c;
     }
   }
-  fields.push_back(field);
   return !in_quotes;
 }
 
@@ -121,20 +127,20 @@ core::Result<std::vector<MeasurementRecord>> readMeasurementLog(const std::files
   std::error_code ec;
   if (!std::filesystem::exists(file, ec))
     return records;
-  std::ifstream in(file);
-  if (!in)
-    return core::Error{file.string() + ": cannot be read"};
-  std::string line;
+  std::string error;
+  const std::optional<std::string> text = core::readWholeFile(file, error);
+  if (!text)
+    return core::Error{std::move(error)};
   std::vector<std::string> fields;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (line.empty() || line == "\r")
-      continue;
+  int next_line = 1;
+  for (std::size_t pos = 0; pos < text->size();) {
+    const int line_number = next_line;  // where the record starts
     const std::string where = file.string() + ":" + std::to_string(line_number) + ": ";
-    if (!splitCsvLine(line, fields))
+    if (!nextCsvRecord(*text, pos, next_line, fields))
       return core::Error{where + "unterminated quoted field"};
-    if (line_number == 1 && !fields.empty() && fields[0] == "session")
+    if (fields.size() == 1 && fields[0].empty())
+      continue;
+    if (line_number == 1 && fields[0] == "session")
       continue;
     if (fields.size() != static_cast<std::size_t>(kColumns)) {
       return core::Error{where + std::to_string(fields.size()) + " fields, expected " +

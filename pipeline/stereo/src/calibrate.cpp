@@ -167,6 +167,14 @@ core::Result<HeadCalibrationReport> calibrateHead(const std::vector<PairCorners>
   std::vector<PairCorners> kept_pairs;
   for (const PairCorners* pair : kept)
     kept_pairs.push_back(*pair);
+  // A calibration the loader would refuse (a baseline in millimetres from a square given in mm,
+  // a degenerate fit from poor views) is an error here, naming the field, and is never written
+  // for a later command to trip over.
+  for (const core::Result<void>& checked : {checkIntrinsics(c), checkExtrinsics(c)}) {
+    if (!checked)
+      return core::Error{"the calibration from these views is not usable: " +
+                         checked.error().message};
+  }
   report.calibration = c;
   report.rms = fit.rms;
   report.epipolar_error_px = epipolarError(c, fit.F, kept_pairs);

@@ -7,6 +7,8 @@
 #include <tuple>
 #include <utility>
 
+#include "fieldrig/core/durable_file.h"
+
 namespace fieldrig::stereo {
 namespace {
 
@@ -353,27 +355,28 @@ core::Result<std::filesystem::path> saveStereoCalibration(const StereoCalibratio
   if (ec) {
     return Error{directory.string() + ": cannot create folder: " + ec.message()};
   }
-  const auto intrinsics = directory / "intrinsics.yml";
-  const auto extrinsics = directory / "extrinsics.yml";
+  std::string intrinsics_text, extrinsics_text;
   try {
-    cv::FileStorage storage(intrinsics.string(), cv::FileStorage::WRITE);
-    if (!storage.isOpened()) {
-      return Error{intrinsics.string() + ": cannot write"};
-    }
+    cv::FileStorage storage(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     storage << "M1" << calibration.M1 << "D1" << calibration.D1 << "M2" << calibration.M2 << "D2"
             << calibration.D2 << "image_width" << calibration.image_size.width << "image_height"
             << calibration.image_size.height;
-    storage.release();
-    cv::FileStorage out(extrinsics.string(), cv::FileStorage::WRITE);
-    if (!out.isOpened()) {
-      return Error{extrinsics.string() + ": cannot write"};
-    }
+    intrinsics_text = storage.releaseAndGetString();
+    cv::FileStorage out(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     out << "R" << calibration.R << "T" << calibration.T << "R1" << calibration.R1 << "R2"
         << calibration.R2 << "P1" << calibration.P1 << "P2" << calibration.P2 << "Q"
         << calibration.Q;
-    out.release();
+    extrinsics_text = out.releaseAndGetString();
   } catch (const cv::Exception& e) {
     return Error{directory.string() + ": writing the calibration failed: " + e.what()};
+  }
+  // Each file is replaced whole, so that a crash leaves the old file or the new one.
+  for (const auto& [name, text] : {std::pair{"intrinsics.yml", &intrinsics_text},
+                                   std::pair{"extrinsics.yml", &extrinsics_text}}) {
+    if (std::string failed =
+            core::replaceFileAtomically(std::filesystem::absolute(directory / name), *text);
+        !failed.empty())
+      return Error{std::move(failed)};
   }
   return directory;
 }

@@ -1,5 +1,6 @@
 #include "fieldrig/traits/cloud_io.h"
 
+#include <pcl/console/print.h>
 #include <pcl/io/ply_io.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -14,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <sstream>
 #include <string_view>
@@ -23,8 +25,9 @@
 // header is trusted: each is checked against what the file's size can hold before anything is
 // reserved, and every error names the file.
 //
-// PLY: our own header check, then PCL's reader for the body. PCL's PLY reader refuses damaged
-//   bodies cleanly but reserves the header's vertex count first (2^31 - 1 → std::bad_alloc).
+// PLY: our own header check (counts against the size; a vertex element with x, y and z), then
+//   PCL's reader for the body. PCL's PLY reader refuses damaged bodies, quietly here, but
+//   reserves the header's vertex count first (2^31 - 1 → std::bad_alloc).
 // PCD: our own reader (header, then ascii, binary or binary_compressed data; x, y, z only) rather
 //   than a check in front of PCL's. PCL 1.13's PCD reader segfaults on an empty file or any text
 //   without a FIELDS line, and throws std::bad_alloc on a huge POINTS; guarding it would mean
@@ -121,6 +124,7 @@ struct PlyElement {
   std::uint64_t count = 0;
   std::uint64_t min_bytes = 0;  // the smallest one element can be written in
   int line = 0;
+  std::vector<std::string> values;  // the names of its properties that are not lists
 };
 
 core::Result<void> checkPlyHeader(const std::string& path, std::uintmax_t file_size) {
@@ -154,7 +158,7 @@ core::Result<void> checkPlyHeader(const std::string& path, std::uintmax_t file_s
       const std::optional<std::uint64_t> count = w.size() == 3 ? parseCount(w[2]) : std::nullopt;
       if (!count)
         return fail(i, "expected 'element NAME COUNT' with a whole COUNT");
-      elements.push_back({w[1], *count, 0, static_cast<int>(i + 1)});
+      elements.push_back({w[1], *count, 0, static_cast<int>(i + 1), {}});
     } else if (w[0] == "property") {
       if (elements.empty())
         return fail(i, "a property before any element");
@@ -168,12 +172,26 @@ core::Result<void> checkPlyHeader(const std::string& path, std::uintmax_t file_s
       // ASCII: at least one digit and a separator per value; a list at least its count, "0 ".
       // Binary: the type's size; a list at least its count.
       elements.back().min_bytes += ascii ? 2 : plyTypeSize(list ? w[2] : w[1]);
+      if (!list)
+        elements.back().values.push_back(w[2]);
     } else {
       return fail(i, "unknown header line '" + w[0] + "'");
     }
   }
   if (!has_format)
     return Error{path + ": no 'format' line in the PLY header"};
+  // Without them PCL's reader says "Failed to find match for field 'x'" on stderr and gives every
+  // point as (0, 0, 0): a cloud of zeros that the traits would take for a plot with no plants.
+  const auto vertex = std::find_if(elements.begin(), elements.end(),
+                                   [](const PlyElement& e) { return e.name == "vertex"; });
+  if (vertex == elements.end())
+    return Error{path + ": no 'vertex' element in the PLY header"};
+  for (const char* axis : {"x", "y", "z"}) {
+    if (std::find(vertex->values.begin(), vertex->values.end(), axis) == vertex->values.end()) {
+      return Error{path + ":" + std::to_string(vertex->line) +
+                   ": the 'vertex' element has no property '" + axis + "'"};
+    }
+  }
   // The last value of an ASCII file may end without a line break.
   const std::uint64_t data_bytes = file_size - header->bytes + (ascii ? 1 : 0);
   std::uint64_t remaining = data_bytes;
@@ -200,6 +218,10 @@ core::Result<void> checkPlyHeader(const std::string& path, std::uintmax_t file_s
 core::Result<Points> loadPly(const std::string& path, std::uintmax_t file_size) {
   if (auto checked = checkPlyHeader(path, file_size); !checked)
     return checked.error();
+  // PCL prints what it dislikes on stderr; this library never prints (its errors name the file),
+  // so PCL's console is kept to nothing for the whole process, once.
+  static std::once_flag quiet;
+  std::call_once(quiet, [] { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); });
   pcl::PointCloud<pcl::PointXYZ> cloud;
   int status = -1;
   try {

@@ -53,6 +53,60 @@ TEST(StemLog, RoundTripsThroughTheCsvFile) {
   EXPECT_EQ(header, csvHeader());
 }
 
+// A label typed with a line break is written quoted across two lines; the rows after it, and the
+// undo of the last one, must still read (before, the file was read one physical line per row).
+TEST(StemLog, ALabelWithLineBreaksRoundTripsAndTheRowsAfterItStayReadable) {
+  testing_support::ScopedTempDir dir("stem_log_line_break");
+  const auto file = dir / "stem.csv";
+  const std::string labels[] = {"row 3\nstem 7", "a\r\nb, \"c\"\n", "\t tab"};
+  for (const std::string& label : labels)
+    ASSERT_TRUE(appendMeasurement(file, record(label, 14.5, 1)).ok());
+  ASSERT_TRUE(appendMeasurement(file, record("plain", 15.5, 1)).ok());
+  auto records = readMeasurementLog(file);
+  ASSERT_TRUE(records.ok()) << records.error().message;
+  ASSERT_EQ(records->size(), 4u);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_EQ((*records)[i].stem_label, labels[i]);
+  EXPECT_EQ((*records)[3].stem_label, "plain");
+  EXPECT_DOUBLE_EQ((*records)[3].diameter_mm, 15.5);
+
+  auto removed = removeLastMeasurement(file, record("", 0, 1).session);
+  ASSERT_TRUE(removed.ok()) << removed.error().message;
+  ASSERT_TRUE(removed->has_value());
+  EXPECT_EQ((*removed)->stem_label, "plain");
+  removed = removeLastMeasurement(file, record("", 0, 1).session);
+  ASSERT_TRUE(removed.ok()) << removed.error().message;
+  EXPECT_EQ((*removed)->stem_label, labels[2]);
+  records = readMeasurementLog(file);
+  ASSERT_TRUE(records.ok()) << records.error().message;
+  ASSERT_EQ(records->size(), 2u);
+  EXPECT_EQ((*records)[1].stem_label, labels[1]);
+}
+
+// A damaged row after a multi-line one is named by the line it starts on; a quoted field the file
+// ends inside is named too.
+TEST(StemLog, ErrorsNameTheLineARecordStartsOn) {
+  testing_support::ScopedTempDir dir("stem_log_record_lines");
+  const auto file = dir / "stem.csv";
+  std::string bad = toCsvRow(record("b", 10.0, 1));
+  bad.replace(bad.find("161.234"), 7, "sixteen");
+  // Line 1 header, lines 2-4 one record (two line breaks in its label), line 5 the bad record.
+  std::ofstream(file) << csvHeader() << '\n'
+                      << toCsvRow(record("a\nb\nc", 10.0, 1)) << '\n'
+                      << bad << '\n';
+  auto damaged = readMeasurementLog(file);
+  ASSERT_FALSE(damaged.ok());
+  EXPECT_NE(damaged.error().message.find("stem.csv:5: field 'disparity_px'"), std::string::npos)
+      << damaged.error().message;
+
+  std::ofstream(file) << csvHeader() << '\n' << toCsvRow(record("a", 10.0, 1)) << "\n\"open";
+  auto unterminated = readMeasurementLog(file);
+  ASSERT_FALSE(unterminated.ok());
+  EXPECT_NE(unterminated.error().message.find("stem.csv:3: unterminated quoted field"),
+            std::string::npos)
+      << unterminated.error().message;
+}
+
 TEST(StemLog, NumbersRepeatsPerStemAndSummarizesMeanAndSd) {
   std::vector<MeasurementRecord> records{record("a", 10.0, 1), record("b", 20.0, 1),
                                          record("a", 12.0, 2), record("a", 14.0, 3)};

@@ -74,6 +74,19 @@ TEST(StereoCalibrate, TooFewBoardsIsAnError) {
   EXPECT_NE(report.error().message.find("found in both images of 0 pairs"), std::string::npos);
 }
 
+// The same views with a square given 100 times too small: the fit is as good, but its 0.8 mm
+// baseline is one that loadStereoCalibration refuses. It is refused here, naming the field, so
+// that `fieldrig calibrate` never writes a calibration a later command trips over.
+TEST(StereoCalibrate, ACalibrationTheLoaderWouldRefuseIsAnError) {
+  const BoardSpec board{{9, 6}, 0.00025};
+  cv::Size size;
+  const std::vector<PairCorners> pairs = samplePairs(board, size);
+  auto report = calibrateHead(pairs, board, size);
+  ASSERT_FALSE(report) << "accepted a baseline of " << report->calibration.baseline() << " m";
+  EXPECT_NE(report.error().message.find("not usable: field 'T'"), std::string::npos)
+      << report.error().message;
+}
+
 // A synthetic head: ideal pinhole cameras 0.12 m apart, rectified by stereoRectify.
 StereoCalibration syntheticHead(double f, cv::Size size, const cv::Mat& D) {
   StereoCalibration c;

@@ -2,14 +2,19 @@
 // naming the file (before: std::bad_alloc for a huge PLY or PCD count, a segfault inside PCL for
 // an empty or garbage .pcd). PCL's own test clouds, ASCII, binary and LZF-compressed, read
 // exactly as PCL reads them.
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "fieldrig/traits/cloud_io.h"
@@ -105,6 +110,42 @@ TEST(CloudIo, PlyWithinTheFileLoads) {
       loadCloud(writeFile(dir, "two_ascii.ply", withCount(kPlyAsciiHead, "2") + "1 2 3\n4 5 6"));
   ASSERT_TRUE(ascii) << ascii.error().message;
   EXPECT_EQ(ascii->size(), 2u);
+}
+
+// What fd 2 receives while `run` runs: PCL prints with fprintf(stderr, …), below std::cerr.
+template <typename Run>
+std::string stderrOf(const ScopedTempDir& dir, Run run) {
+  std::fflush(stderr);
+  const int saved = ::dup(2);
+  const std::string path = (dir / "stderr.txt").string();
+  const int file = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  ::dup2(file, 2);
+  run();
+  std::fflush(stderr);
+  ::dup2(saved, 2);
+  ::close(saved);
+  ::close(file);
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A vertex element without x, y or z: PCL's reader printed "Failed to find match for field 'x'"
+// and gave every point as (0, 0, 0), which `fieldrig traits` took for a plot without plants
+// (exit 0). Now refused, naming the line; and nothing PCL says reaches stderr.
+TEST(CloudIo, PlyWithoutXyzIsRefusedAndPclPrintsNothing) {
+  ScopedTempDir dir("cloud_io_ply_no_xyz");
+  std::string no_z = withCount(kPlyAsciiHead, "2") + "1 2 3\n4 5 6\n";
+  no_z.replace(no_z.find("property float z"), 16, "property float w");
+  expectRefused(writeFile(dir, "no_z.ply", no_z), ":3: the 'vertex' element has no property 'z'");
+  expectRefused(writeFile(dir, "faces.ply",
+                          "ply\nformat ascii 1.0\nelement face 1\nproperty list uchar int "
+                          "vertex_indices\nend_header\n3 0 1 2\n"),
+                "no 'vertex' element");
+  const std::string err = stderrOf(dir, [&] {
+    EXPECT_FALSE(loadCloud(
+        writeFile(dir, "cut.ply", withCount(kPlyAsciiHead, "3") + "1 2 3\n4 5 6\n7.5 8\n")));
+  });
+  EXPECT_EQ(err, "");
 }
 
 // PCL's test clouds: ASCII (bun0, sac_plane_test) and LZF-compressed binary (the others), read

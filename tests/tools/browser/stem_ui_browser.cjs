@@ -43,7 +43,7 @@ async function checkBadRequests() {
     ["GET", "/api/sessions/" + s + "/sets/0/%2e%2e/left.png", null, 400, "path traversal"],
     ["GET", "/api/sessions/" + s + "/sets/999/bottom/left.png", null, 404, "has no set"],
     ["GET", "/api/sessions/" + s + "/sets/zero/bottom/left.png", null, 400, "not a set index"],
-    ["GET", "/api/sessions/" + s + "/sets/0/nohead/left.png", null, 404, "no camera"],
+    ["GET", "/api/sessions/" + s + "/sets/0/nohead/left.png", null, 404, "has no head"],
     ["POST", "/api/sessions/" + s + "/measure", "{not json", 400, "not a JSON object"],
     ["POST", "/api/sessions/" + s + "/measure",
      '{"set":0,"head":"bottom","points":[1,2,3,"x",5,6,7,8]}', 400, "points[3]"],

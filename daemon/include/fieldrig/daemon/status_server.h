@@ -1,4 +1,4 @@
-// The daemon's status on a local HTTP port (Boost.Beast): GET /status answers the JSON snapshot
+// The daemon's status on a local HTTP port (HttpServer): GET /status answers the JSON snapshot
 // the daemon provides; GET /healthz answers "ok". Read-only: nothing a request carries can change
 // the run or reach a file. It runs on its own thread, so a slow or hostile client never delays
 // the GPS/trigger thread; it listens on 127.0.0.1 unless configured otherwise.

@@ -33,8 +33,9 @@ struct MeasurementRecord {
 std::string csvHeader();
 std::string toCsvRow(const MeasurementRecord& record);  // no newline
 
-// Reads a file written with csvHeader/toCsvRow; a missing file is an empty log. The error names
-// the file, line and field.
+// Reads a file written with csvHeader/toCsvRow (RFC 4180: a quoted field may hold a line break,
+// so a record may take several lines); a missing file is an empty log. The error names the file,
+// the line where the record starts and the field.
 core::Result<std::vector<MeasurementRecord>> readMeasurementLog(const std::filesystem::path& file);
 
 // Appends one row (writing the header first when the file is new or empty) and waits until it

@@ -70,7 +70,7 @@ struct HeadCalibrationReport {
 };
 
 // Calibrates one head from corners found in `pairs` (images `image_size`). The error says why
-// (too few boards found, …).
+// (too few boards found, a result that checkIntrinsics/checkExtrinsics refuse, …).
 core::Result<HeadCalibrationReport> calibrateHead(const std::vector<PairCorners>& pairs,
                                                   const BoardSpec& board, cv::Size image_size,
                                                   const CalibrateOptions& options = {});
