@@ -137,6 +137,7 @@ TEST(MinTexture, FlatRegionsGiveNoDisparityTexturedOnesKeepTheirs) {
   pair.right(flat_left - cv::Point(kDisparity, 0)).setTo(250);
   MatcherOptions options;
   options.num_disparities = 32;
+  options.min_texture = 0.0;
   const cv::Mat kept = DisparityMatcher(options).compute(pair.left, pair.right);
   options.min_texture = 2.0;
   const cv::Mat masked = DisparityMatcher(options).compute(pair.left, pair.right);
