@@ -73,7 +73,8 @@ main() {
     calibration_yaml)
       # The stereo calibration (pipeline/stereo) and the rig's rig.yml (pipeline/cloud): their
       # loaders only, not the two libraries.
-      sources=(pipeline/stereo/src/calibration.cpp pipeline/cloud/src/rig_calibration.cpp)
+      sources=(pipeline/stereo/src/calibration.cpp pipeline/cloud/src/rig_calibration.cpp
+               core/src/durable_file.cpp)
       includes+=(pipeline/stereo/include pipeline/cloud/include)
       system_includes=(/usr/include/opencv4)
       libs=(-lopencv_calib3d -lopencv_core)
