@@ -62,11 +62,10 @@ main() {
       includes+=(recording/include)
       ;;
     cloud_file)
-      # PCL's PLY reader reads the body: the fuzzer links pcl_io, as the traits library does.
+      # Both readers are the project's own: no PCL.
       sources=(pipeline/traits/src/cloud_io.cpp)
       includes+=(pipeline/traits/include)
-      system_includes=(/usr/include/eigen3 /usr/include/pcl-1.13)
-      libs=(-lpcl_io -lpcl_common)
+      system_includes=(/usr/include/eigen3)
       seed_files=("$data"/pointclouds/pcl/*.pcd)
       max_len=16384
       ;;
