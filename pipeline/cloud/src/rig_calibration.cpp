@@ -1,9 +1,11 @@
 #include "fieldrig/cloud/rig_calibration.h"
 
+#include <cctype>
 #include <cmath>
 #include <sstream>
 
 #include "fieldrig/cloud/cloud_options.h"
+#include "fieldrig/core/durable_file.h"
 
 namespace fieldrig::cloud {
 namespace {
@@ -14,15 +16,26 @@ using core::Error;
 bool readMatx(const cv::FileNode& node, int rows, int cols, cv::Mat& out) {
   if (node.empty())
     return false;
-  try {
-    node >> out;
-  } catch (const cv::Exception&) {
+  core::Result<cv::Mat> matrix = stereo::readCalibrationMatrix(node);
+  if (!matrix || matrix->rows != rows || matrix->cols != cols)
     return false;
+  out = std::move(*matrix);
+  return true;
+}
+
+// A head's name is also its calibration folder beside rig.yml and its frames' folder in a
+// session: a plain name, never a path.
+core::Result<void> checkHeadName(const std::string& name) {
+  if (name.empty() || name.size() > 64 || name == "." || name == "..")
+    return Error{"'" + name + "' is not a head name"};
+  for (const char c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') {
+      return Error{"'" + name +
+                   "' is not a head name (letters, digits, '_', '-' and '.' only: it names a "
+                   "folder)"};
+    }
   }
-  if (out.rows != rows || out.cols != cols)
-    return false;
-  out.convertTo(out, CV_64F);
-  return cv::checkRange(out);
+  return {};
 }
 
 // Heads ride on one rig: a head more than this far from the bottom one is a transform in
@@ -47,24 +60,11 @@ core::Result<void> checkHeadTransform(const cv::Matx44d& transform) {
   return {};
 }
 
-}  // namespace
-
-core::Result<RigCalibration> loadRigCalibration(const fs::path& directory) {
+core::Result<RigCalibration> loadCheckedRig(const fs::path& directory) {
   const fs::path file = directory / "rig.yml";
-  // Checked first so that OpenCV does not log its own error for a missing file.
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) {
-    return Error{file.string() + ": cannot open"};
-  }
   cv::FileStorage storage;
-  try {
-    storage.open(file.string(), cv::FileStorage::READ);
-  } catch (const cv::Exception&) {
-    return Error{file.string() + ": not a readable OpenCV YAML file"};
-  }
-  if (!storage.isOpened()) {
-    return Error{file.string() + ": cannot open"};
-  }
+  if (auto opened = stereo::openCalibrationFile(file, storage); !opened)
+    return opened.error();
   RigCalibration rig;
   const cv::FileNode heads = storage["heads"];
   if (heads.empty() || !heads.isSeq()) {
@@ -76,6 +76,12 @@ core::Result<RigCalibration> loadRigCalibration(const fs::path& directory) {
       return Error{file.string() + ": field 'heads' holds something that is not a name"};
     }
     head.name = static_cast<std::string>(head_node);
+    if (auto checked = checkHeadName(head.name); !checked)
+      return Error{file.string() + ": field 'heads': " + checked.error().message};
+    for (const HeadCalibration& earlier : rig.heads) {
+      if (earlier.name == head.name)
+        return Error{file.string() + ": field 'heads' names '" + head.name + "' twice"};
+    }
     const std::string key = head.name + "_to_bottom";
     cv::Mat transform;
     if (storage[key].empty()) {
@@ -149,18 +155,35 @@ core::Result<RigCalibration> loadRigCalibration(const fs::path& directory) {
   return rig;
 }
 
+}  // namespace
+
+core::Result<RigCalibration> loadRigCalibration(const fs::path& directory) {
+  // A node of another type than the one asked for throws inside OpenCV; whatever escapes the
+  // checks is still a damaged file, not a crash.
+  try {
+    return loadCheckedRig(directory);
+  } catch (const std::exception& e) {
+    return Error{(directory / "rig.yml").string() + ": not a readable rig calibration (" +
+                 e.what() + ")"};
+  }
+}
+
 core::Result<fs::path> saveRigCalibration(const RigCalibration& rig, const fs::path& directory) {
+  const fs::path file = directory / "rig.yml";
+  // Before anything is written: a name with a path in it would write outside `directory`.
+  for (const HeadCalibration& head : rig.heads) {
+    if (auto checked = checkHeadName(head.name); !checked)
+      return Error{file.string() + ": " + checked.error().message};
+  }
   for (const HeadCalibration& head : rig.heads) {
     core::Result<fs::path> saved =
         stereo::saveStereoCalibration(head.stereo, directory / head.name);
     if (!saved)
       return saved.error();
   }
-  const fs::path file = directory / "rig.yml";
+  std::string text;
   try {
-    cv::FileStorage storage(file.string(), cv::FileStorage::WRITE);
-    if (!storage.isOpened())
-      return Error{file.string() + ": cannot write"};
+    cv::FileStorage storage(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     storage << "heads"
             << "[";
     for (const HeadCalibration& head : rig.heads)
@@ -171,9 +194,13 @@ core::Result<fs::path> saveRigCalibration(const RigCalibration& rig, const fs::p
     }
     storage << "plot_rotation" << cv::Mat(rig.plot_rotation) << "pixel_format"
             << std::string(core::toString(rig.pixel_format));
+    text = storage.releaseAndGetString();
   } catch (const cv::Exception& e) {
     return Error{file.string() + ": cannot write: " + e.what()};
   }
+  // Replaced whole, so that a crash leaves the old file or the new one.
+  if (std::string failed = core::replaceFileAtomically(fs::absolute(file), text); !failed.empty())
+    return Error{std::move(failed)};
   return directory;
 }
 

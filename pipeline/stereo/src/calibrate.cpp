@@ -1,5 +1,7 @@
 #include "fieldrig/stereo/calibrate.h"
 
+#include "fieldrig/core/durable_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -272,14 +274,30 @@ core::Result<HeadToHeadReport> calibrateHeadToHead(StereoCalibration head_a,
 
 core::Result<std::filesystem::path> saveHeadToHead(const HeadToHeadReport& report,
                                                    const std::filesystem::path& file) {
+  // What is written is what rig.yml's `*_to_bottom` takes: refused here rather than when the rig
+  // is loaded next, far from the calibration that made it.
+  const cv::Matx44d& t = report.b_to_a;
+  if (!cv::checkRange(cv::Mat(t)) || !std::isfinite(report.rms))
+    return core::Error{file.string() + ": the head-to-head transform is not finite; not written"};
+  if (auto rotation = checkRotation(t.get_minor<3, 3>(0, 0)); !rotation)
+    return core::Error{file.string() + ": the head-to-head transform: " + rotation.error().message +
+                       "; not written"};
+  if (t(3, 0) != 0 || t(3, 1) != 0 || t(3, 2) != 0 || t(3, 3) != 1)
+    return core::Error{file.string() +
+                       ": the head-to-head transform's bottom row is not "
+                       "(0 0 0 1); not written"};
+  std::string text;
   try {
-    cv::FileStorage storage(file.string(), cv::FileStorage::WRITE);
-    if (!storage.isOpened())
-      return core::Error{file.string() + ": cannot write"};
+    cv::FileStorage storage(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     storage << "b_to_a" << cv::Mat(report.b_to_a) << "rms" << report.rms;
+    text = storage.releaseAndGetString();
   } catch (const cv::Exception&) {
     return core::Error{file.string() + ": cannot write"};
   }
+  // Replaced whole, so that a crash leaves the old file or the new one.
+  if (std::string failed = core::replaceFileAtomically(std::filesystem::absolute(file), text);
+      !failed.empty())
+    return core::Error{std::move(failed)};
   return file;
 }
 

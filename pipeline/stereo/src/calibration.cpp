@@ -1,7 +1,10 @@
 #include "fieldrig/stereo/calibration.h"
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <opencv2/calib3d.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -17,32 +20,23 @@ using core::Error;
 // Reads a CV_64F matrix of the given shape (cols < 0: any column count) from `storage`.
 bool readMatrix(const cv::FileStorage& storage, const std::string& key, int rows, int cols,
                 cv::Mat& out, const std::filesystem::path& file, std::string& error) {
-  cv::FileNode node = storage[key];
+  const cv::FileNode node = storage[key];
   if (node.empty()) {
     error = file.string() + ": field '" + key + "' is missing";
     return false;
   }
-  cv::Mat matrix;
-  try {
-    node >> matrix;
-  } catch (const cv::Exception&) {
-    matrix.release();
-  }
-  if (matrix.empty()) {
-    error = file.string() + ": field '" + key + "' is not a matrix";
+  core::Result<cv::Mat> matrix = readCalibrationMatrix(node);
+  if (!matrix) {
+    error = file.string() + ": field '" + key + "' " + matrix.error().message;
     return false;
   }
-  if (matrix.rows != rows || (cols >= 0 && matrix.cols != cols)) {
-    error = file.string() + ": field '" + key + "' is " + std::to_string(matrix.rows) + "x" +
-            std::to_string(matrix.cols) + ", expected " + std::to_string(rows) + "x" +
+  if (matrix->rows != rows || (cols >= 0 && matrix->cols != cols)) {
+    error = file.string() + ": field '" + key + "' is " + std::to_string(matrix->rows) + "x" +
+            std::to_string(matrix->cols) + ", expected " + std::to_string(rows) + "x" +
             (cols >= 0 ? std::to_string(cols) : std::string("N"));
     return false;
   }
-  matrix.convertTo(out, CV_64F);
-  if (!cv::checkRange(out)) {
-    error = file.string() + ": field '" + key + "' holds NaN or infinite values";
-    return false;
-  }
+  out = std::move(*matrix);
   return true;
 }
 
@@ -276,25 +270,96 @@ StereoCalibration idealStereoCalibration(double focal_px, cv::Size image_size, d
   return c;
 }
 
-core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::path& intrinsics,
-                                                      const std::filesystem::path& extrinsics) {
+core::Result<void> openCalibrationFile(const std::filesystem::path& file,
+                                       cv::FileStorage& storage) {
+  // Checked first so that OpenCV does not log its own error for a missing file.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    return Error{file.string() + ": cannot open"};
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  if (ec)
+    return Error{file.string() + ": cannot read its size: " + ec.message()};
+  if (size > kMaxCalibrationFileBytes) {
+    return Error{file.string() + ": " + std::to_string(size) +
+                 " bytes, more than a calibration file holds (at most " +
+                 std::to_string(kMaxCalibrationFileBytes) + ")"};
+  }
+  std::string text(static_cast<std::size_t>(size), '\0');
+  std::ifstream in(file, std::ios::binary);
+  if (!in || !in.read(text.data(), static_cast<std::streamsize>(text.size())))
+    return Error{file.string() + ": cannot read"};
+  int line = 1;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\n')
+      ++line;
+    else if ((byte < 0x20 && c != '\t' && c != '\r') || byte == 0x7f) {
+      char code[8];
+      std::snprintf(code, sizeof code, "0x%02x", byte);
+      return Error{file.string() + ":" + std::to_string(line) + ": control character " + code +
+                   ": a damaged file, not OpenCV YAML/XML"};
+    }
+  }
+  try {
+    storage.open(file.string(), cv::FileStorage::READ);
+    if (!storage.isOpened())
+      return Error{file.string() + ": cannot open"};
+    if (!storage.root().isMap())
+      return Error{file.string() + ": not a map of fields (OpenCV YAML/XML)"};
+  } catch (const std::exception& e) {  // cv::Exception, and std::length_error from its parser
+    return Error{file.string() + ": not a readable OpenCV YAML/XML file"};
+  }
+  return {};
+}
+
+core::Result<cv::Mat> readCalibrationMatrix(const cv::FileNode& node) {
+  const auto side = [&](const char* key) -> std::optional<int> {
+    const cv::FileNode value = node[key];
+    if (!value.isInt())
+      return std::nullopt;
+    const int n = static_cast<int>(value);
+    if (n < 1 || n > kMaxCalibrationMatrixSide)
+      return std::nullopt;
+    return n;
+  };
+  if (!node.isMap() || !node["sizes"].empty())
+    return Error{"is not a matrix (rows, cols, dt, data)"};
+  const std::optional<int> rows = side("rows");
+  const std::optional<int> cols = side("cols");
+  if (!rows || !cols) {
+    return Error{"is not a matrix of 1 to " + std::to_string(kMaxCalibrationMatrixSide) +
+                 " rows and columns"};
+  }
+  const cv::FileNode data = node["data"];
+  if (!data.isSeq() || data.size() != static_cast<std::size_t>(*rows * *cols)) {
+    return Error{"does not hold its " + std::to_string(*rows) + "x" + std::to_string(*cols) +
+                 " values"};
+  }
+  cv::Mat matrix;
+  try {
+    node >> matrix;  // its size is checked above: nothing large is allocated
+  } catch (const std::exception&) {
+    matrix.release();
+  }
+  if (matrix.empty() || matrix.rows != *rows || matrix.cols != *cols || matrix.channels() != 1)
+    return Error{"is not a matrix (rows, cols, dt, data)"};
+  cv::Mat out;
+  matrix.convertTo(out, CV_64F);
+  if (!cv::checkRange(out))
+    return Error{"holds NaN or infinite values"};
+  return out;
+}
+
+namespace {
+
+core::Result<StereoCalibration> loadCheckedFiles(const std::filesystem::path& intrinsics,
+                                                 const std::filesystem::path& extrinsics) {
   StereoCalibration calibration;
   std::string error;
   {
     cv::FileStorage storage;
-    // Checked first so that OpenCV does not log its own error for a missing file.
-    std::error_code exists_error;
-    if (!std::filesystem::is_regular_file(intrinsics, exists_error)) {
-      return Error{intrinsics.string() + ": cannot open"};
-    }
-    try {
-      storage.open(intrinsics.string(), cv::FileStorage::READ);
-    } catch (const cv::Exception& e) {
-      return Error{intrinsics.string() + ": not a readable OpenCV YAML/XML file"};
-    }
-    if (!storage.isOpened()) {
-      return Error{intrinsics.string() + ": cannot open"};
-    }
+    if (auto opened = openCalibrationFile(intrinsics, storage); !opened)
+      return opened.error();
     if (!readMatrix(storage, "M1", 3, 3, calibration.M1, intrinsics, error) ||
         !readMatrix(storage, "D1", 1, -1, calibration.D1, intrinsics, error) ||
         !readMatrix(storage, "M2", 3, 3, calibration.M2, intrinsics, error) ||
@@ -316,19 +381,8 @@ core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::pat
   }
   {
     cv::FileStorage storage;
-    // Checked first so that OpenCV does not log its own error for a missing file.
-    std::error_code exists_error;
-    if (!std::filesystem::is_regular_file(extrinsics, exists_error)) {
-      return Error{extrinsics.string() + ": cannot open"};
-    }
-    try {
-      storage.open(extrinsics.string(), cv::FileStorage::READ);
-    } catch (const cv::Exception& e) {
-      return Error{extrinsics.string() + ": not a readable OpenCV YAML/XML file"};
-    }
-    if (!storage.isOpened()) {
-      return Error{extrinsics.string() + ": cannot open"};
-    }
+    if (auto opened = openCalibrationFile(extrinsics, storage); !opened)
+      return opened.error();
     if (!readMatrix(storage, "R", 3, 3, calibration.R, extrinsics, error) ||
         !readMatrix(storage, "T", 3, 1, calibration.T, extrinsics, error) ||
         !readMatrix(storage, "R1", 3, 3, calibration.R1, extrinsics, error) ||
@@ -342,6 +396,20 @@ core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::pat
   if (auto checked = withFile(extrinsics, checkExtrinsics(calibration)); !checked)
     return checked.error();
   return calibration;
+}
+
+}  // namespace
+
+core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::path& intrinsics,
+                                                      const std::filesystem::path& extrinsics) {
+  // A node of another type than the one asked for throws inside OpenCV; whatever escapes the
+  // checks above is still a damaged file, not a crash.
+  try {
+    return loadCheckedFiles(intrinsics, extrinsics);
+  } catch (const std::exception& e) {
+    return Error{intrinsics.string() + " / " + extrinsics.string() +
+                 ": not a readable calibration (" + e.what() + ")"};
+  }
 }
 
 core::Result<StereoCalibration> loadStereoCalibration(const std::filesystem::path& directory) {
@@ -359,8 +427,13 @@ core::Result<std::filesystem::path> saveStereoCalibration(const StereoCalibratio
   try {
     cv::FileStorage storage(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     storage << "M1" << calibration.M1 << "D1" << calibration.D1 << "M2" << calibration.M2 << "D2"
-            << calibration.D2 << "image_width" << calibration.image_size.width << "image_height"
-            << calibration.image_size.height;
+            << calibration.D2;
+    // Without a size (OpenCV's own sample files have none) the keys stay out: 0 would be refused
+    // when the file is loaded again.
+    if (!calibration.image_size.empty()) {
+      storage << "image_width" << calibration.image_size.width << "image_height"
+              << calibration.image_size.height;
+    }
     intrinsics_text = storage.releaseAndGetString();
     cv::FileStorage out(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
     out << "R" << calibration.R << "T" << calibration.T << "R1" << calibration.R1 << "R2"

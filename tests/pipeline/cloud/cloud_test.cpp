@@ -205,6 +205,43 @@ TEST(Rig, ErrorsNameFileAndField) {
                 "0.001)");
 }
 
+// A head's name is the folder of its calibration (and of its frames in a session): a name with a
+// path in it reached files outside the calibration folder. Damaged files are errors, not crashes.
+TEST(Rig, HeadNamesAreFolderNamesAndDamagedFilesAreRefused) {
+  ScopedTempDir dir("cloud_rig_names");
+  ASSERT_TRUE(saveRigCalibration(syntheticRig(), dir.path()));
+  const std::string file = (dir.path() / "rig.yml").string();
+  const auto withRig = [&](const std::string& text) {
+    std::ofstream(dir.path() / "rig.yml", std::ios::binary | std::ios::trunc) << text;
+    return loadRigCalibration(dir.path());
+  };
+  for (const char* name : {"../bottom", "/etc", "..", "a b", ""}) {
+    const auto loaded = withRig(std::string("%YAML:1.0\nheads: [ \"") + name + "\" ]\n");
+    ASSERT_FALSE(loaded) << name;
+    EXPECT_EQ(loaded.error().message.rfind(file + ": field 'heads': '" + name + "'", 0), 0u)
+        << loaded.error().message;
+  }
+  const auto twice = withRig("%YAML:1.0\nheads: [ bottom, bottom ]\n");
+  ASSERT_FALSE(twice);
+  EXPECT_NE(twice.error().message.find("names 'bottom' twice"), std::string::npos)
+      << twice.error().message;
+  const auto not_map = withRig("%YAML:1.0\n- bottom\n- top\n");
+  ASSERT_FALSE(not_map);
+  EXPECT_EQ(not_map.error().message, file + ": not a map of fields (OpenCV YAML/XML)");
+  const auto huge = withRig(
+      "%YAML:1.0\nheads: [ bottom ]\nplot_rotation: !!opencv-matrix\n  rows: 3\n"
+      "  cols: 2147483647\n  dt: d\n  data: [ 1 ]\n");
+  ASSERT_FALSE(huge);
+  EXPECT_EQ(huge.error().message, file + ": field 'plot_rotation' is not a finite 3x3 matrix");
+
+  RigCalibration bad_name = syntheticRig();
+  bad_name.heads[1].name = "../elsewhere";
+  const auto saved = saveRigCalibration(bad_name, dir.path() / "out");
+  ASSERT_FALSE(saved);
+  EXPECT_NE(saved.error().message.find("'../elsewhere' is not a head name"), std::string::npos)
+      << saved.error().message;
+}
+
 // Each kind of unusable head transform is refused naming rig.yml and the field; a head's own
 // unusable calibration names its file (before, all of these loaded).
 TEST(Rig, HeadTransformsAndHeadCalibrationsAreChecked) {

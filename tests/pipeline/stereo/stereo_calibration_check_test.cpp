@@ -65,6 +65,55 @@ TEST(CalibrationCheck, OpenCvsShippedIntrinsicsLoad) {
   EXPECT_TRUE(loaded->image_size.empty());
 }
 
+// What cv::FileStorage did with damaged files, before the loaders checked them first: a declared
+// size was allocated before its data was read (16 GiB for "cols: 2147483647"), control bytes could
+// hang open(), std::length_error and cv::Exception escaped.
+TEST(CalibrationCheck, DamagedFilesAreRefusedBeforeOpenCvTrustsThem) {
+  ScopedTempDir dir("calib_check_damaged");
+  ASSERT_TRUE(saveStereoCalibration(goodCalibration(), dir.path()));
+  const auto withIntrinsics = [&](const std::string& text) {
+    std::ofstream(dir / "intrinsics.yml", std::ios::binary | std::ios::trunc) << text;
+    return loadStereoCalibration(dir.path());
+  };
+  const std::string file = (dir / "intrinsics.yml").string();
+  const auto expectMessage = [&](const core::Result<StereoCalibration>& loaded,
+                                 const std::string& what) {
+    ASSERT_FALSE(loaded) << "accepted; expected " << what;
+    EXPECT_EQ(loaded.error().message.rfind(file + ":", 0), 0u) << loaded.error().message;
+    EXPECT_NE(loaded.error().message.find(what), std::string::npos) << loaded.error().message;
+  };
+  const std::string huge =
+      "%YAML:1.0\nM1: !!opencv-matrix\n  rows: 2147483647\n  cols: 2147483647\n  dt: d\n"
+      "  data: [ 1 ]\n";
+  expectMessage(withIntrinsics(huge), "field 'M1' is not a matrix of 1 to 16 rows and columns");
+  expectMessage(withIntrinsics("%YAML:1.0\nM1: !!opencv-nd-matrix\n  sizes: [ 3, 3, 3 ]\n"
+                               "  dt: d\n  data: [ 1 ]\n"),
+                "field 'M1' is not a matrix (rows, cols, dt, data)");
+  expectMessage(withIntrinsics("%YAML:1.0\nM1: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n"
+                               "  data: [ 1, 0, 0 ]\n"),
+                "field 'M1' does not hold its 3x3 values");
+  expectMessage(withIntrinsics(std::string("---  dt: d\n d\x05\0\0x\n", 18)),
+                ":2: control character 0x05");
+  expectMessage(withIntrinsics("%YAML:1.0\n- x\n- y\n"), "not a map of fields");
+  expectMessage(withIntrinsics("- x\n- y\n"), "not a readable OpenCV YAML/XML file");
+  expectMessage(withIntrinsics("%YAML:1.0\n:1.0\n"), "not a readable OpenCV YAML/XML file");
+  expectMessage(withIntrinsics(std::string(kMaxCalibrationFileBytes + 1, ' ')),
+                "more than a calibration file holds");
+}
+
+// OpenCV's own sample calibrations have no image size: saved again they leave the keys out
+// rather than write 0, which the loader refuses.
+TEST(CalibrationCheck, ACalibrationWithoutImageSizeRoundTrips) {
+  ScopedTempDir dir("calib_check_no_size");
+  StereoCalibration calibration = goodCalibration();
+  calibration.image_size = cv::Size();
+  ASSERT_TRUE(saveStereoCalibration(calibration, dir.path()));
+  const auto loaded = loadStereoCalibration(dir.path());
+  ASSERT_TRUE(loaded) << loaded.error().message;
+  EXPECT_TRUE(loaded->image_size.empty());
+  EXPECT_EQ(cv::norm(loaded->M1, calibration.M1), 0.0);
+}
+
 TEST(CalibrationCheck, SingularCameraMatrix) {
   ScopedTempDir dir("calib_check_zero_m1");
   expectRefused(

@@ -7,6 +7,7 @@
 // without them (OpenCV's own) load with an empty image_size, and users take the images' size.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
 
@@ -66,6 +67,20 @@ inline constexpr int kMaxImageSide = 32767;
 // in mm), one under 1 mm a zeroed or mistyped T.
 inline constexpr double kMinBaselineM = 1e-3;
 inline constexpr double kMaxBaselineM = 10.0;
+
+// OpenCV YAML/XML files as every calibration loader reads them. cv::FileStorage trusts what a file
+// says: `node >> mat` allocates the declared rows x cols before reading the data (16 GiB for
+// "cols: 2147483647"), open() can hang on control bytes and throws std::length_error on some
+// damaged files, and indexing a file whose top is not a map throws. These check first and turn
+// every failure into an error naming the file (and the line or field).
+//   openCalibrationFile: a regular file of at most kMaxCalibrationFileBytes, without control
+//     characters other than tab and line breaks, that OpenCV opens as a map of fields.
+//   readCalibrationMatrix: a 2-D matrix node of at most kMaxCalibrationMatrixSide rows and columns
+//     whose data has rows x cols finite values, as CV_64F; the error says what is wrong with it.
+inline constexpr std::uintmax_t kMaxCalibrationFileBytes = 1 << 20;
+inline constexpr int kMaxCalibrationMatrixSide = 16;
+core::Result<void> openCalibrationFile(const std::filesystem::path& file, cv::FileStorage& storage);
+core::Result<cv::Mat> readCalibrationMatrix(const cv::FileNode& node);
 
 // Reads the two files and checks them (checkIntrinsics, checkExtrinsics); the error names the
 // file and the missing, malformed or implausible field.
