@@ -69,6 +69,11 @@ struct TriggerChainOptions {
   // Receiver and serial latency: from the fix's time to its last byte reaching the host. RTK
   // receivers output 20-50 ms after the epoch, and two sentences take ~10 ms at 115200 baud.
   double latency_s = 0.05;
+  // Replay only (the live chain sees the real arrivals): each fix becomes usable at its time +
+  // latency_s + a uniform draw in ±latency_jitter_s (at most latency_s), seeded: the receiver's
+  // computation and serial queueing vary the latency from fix to fix.
+  double latency_jitter_s = 0;
+  std::uint32_t latency_jitter_seed = 1;
 };
 
 enum class AlarmKind {
