@@ -5,6 +5,7 @@
 // Prints a Markdown table.
 //
 //   trigger_accuracy_bench [--seeds N] [--noise M] [--velocity-noise M/S] [--latency S]
+//                          [--jerk-density Q] [--position-sd M] [--velocity-sd M/S]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -119,7 +120,14 @@ int run(int argc, char** argv) {
   double noise = 0.01;
   double velocity_noise = 0.02;
   double latency = gps::TriggerChainOptions{}.latency_s;
+  gps::TriggerOptions planner;  // the Kalman filter's noise settings can be tried from here
   for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--jerk-density"))
+      planner.kalman_jerk_density = std::atof(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--position-sd"))
+      planner.kalman_position_sd_m = std::atof(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--velocity-sd"))
+      planner.kalman_velocity_sd_mps = std::atof(argv[i + 1]);
     if (!std::strcmp(argv[i], "--seeds"))
       seeds = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--noise"))
@@ -146,8 +154,10 @@ int run(int argc, char** argv) {
   std::printf(
       "Trigger accuracy along track: %zu locations x %d seeds per row, 10 Hz, position noise "
       "%.1f cm per axis (white, or Gauss-Markov tau 10 s in '+ correlated'), velocity noise "
-      "%.1f cm/s per axis, latency %.0f ms, serpentine rows\n\n",
-      map->size(), seeds, noise * 100, velocity_noise * 100, latency * 1000);
+      "%.1f cm/s per axis, latency %.0f ms, serpentine rows; Kalman jerk density %g m2/s5, "
+      "position SD %g m, velocity SD %g m/s\n\n",
+      map->size(), seeds, noise * 100, velocity_noise * 100, latency * 1000,
+      planner.kalman_jerk_density, planner.kalman_position_sd_m, planner.kalman_velocity_sd_mps);
   std::printf(
       "| %-15s | %-21s | m/s | once/total | wrong | mean cm | p95 cm | max cm | bias cm | "
       "sigma cm | ms/run |\n",
@@ -182,6 +192,7 @@ int run(int argc, char** argv) {
         for (std::size_t m = 0; m < std::size(models); ++m) {
           std::vector<core::TriggerEvent> events;
           gps::TriggerChainOptions replay;
+          replay.planner = planner;
           replay.latency_s = latency;
           replay.latency_jitter_s = scenario.latency_jitter_s;
           replay.latency_jitter_seed = static_cast<std::uint32_t>(seed);
