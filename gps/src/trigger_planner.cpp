@@ -352,12 +352,19 @@ struct TriggerPlanner::State {
       }
     }
     if (!filter.initialised()) {
-      // Started from a straight line through the first few fixes; it must fit them.
-      double rms = 0;
-      const std::optional<Track> fit = fitTrack(samples, 0, &rms);
-      if (!fit || rms > options.fit_residual_limit_m)
+      // Started from a straight line through the recent fixes; the oldest give way until it
+      // fits them (the one bad fix that reset the filter, the turn before the row).
+      while (samples.size() >= kMinFitSamples) {
+        double rms = 0;
+        const std::optional<Track> fit = fitTrack(samples, 0, &rms);
+        if (fit && rms <= options.fit_residual_limit_m) {
+          filter.initialise(*fit);
+          break;
+        }
+        samples.pop_front();
+      }
+      if (!filter.initialised())
         return;
-      filter.initialise(*fit);
     } else {
       filter.updatePosition(newest.east, newest.north);
     }
