@@ -1,8 +1,11 @@
 // Whole-run benchmark: trigger accuracy along track on simulated serpentine drives (10 Hz, RTK
-// noise), at 1, 2 and 3 m/s, for the predictive planner and, in the same run on the same NMEA,
-// the naive rule "fire on the first fix past the location". Prints a Markdown table.
+// noise), at 1, 2 and 3 m/s, at constant speed and with the speed changes, correlated noise and
+// latency jitter of a real drive, for both of the planner's motion models and (at constant speed)
+// the naive rule "fire on the first fix past the location", all in the same run on the same NMEA.
+// Prints a Markdown table.
 //
-//   trigger_accuracy_bench [--seeds N] [--noise M] [--latency S]
+//   trigger_accuracy_bench [--seeds N] [--noise M] [--velocity-noise M/S] [--latency S]
+//                          [--jerk-density Q] [--position-sd M] [--velocity-sd M/S]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -64,11 +67,26 @@ std::vector<core::TriggerEvent> naiveTriggers(const std::string& nmea, const gps
   return events;
 }
 
-void printRow(const char* method, double speed, const sim::TriggerAccuracy& a, double ms_per_run) {
-  std::printf("| %-28s | %3.1f | %4zu/%4zu | %5zu | %6.2f | %6.2f | %6.2f | %+6.2f | %8.1f |\n",
-              method, speed, a.fired_once, a.locations, a.fired_more_than_once + a.never_fired,
-              a.mean_abs_m * 100, a.p95_abs_m * 100, a.max_abs_m * 100, a.mean_signed_m * 100,
-              ms_per_run);
+struct Scenario {
+  const char* name;
+  double slow_amplitude = 0;  // speed breathing, fractions of the mean speed
+  double fast_amplitude = 0;
+  double white_noise_m = 0;
+  double correlated_noise_m = 0;  // Gauss-Markov, tau 10 s
+  double latency_jitter_s = 0;
+};
+
+void printRow(const Scenario& scenario, const char* method, double speed,
+              const sim::TriggerAccuracy& a, double mean_sigma_m, double ms_per_run) {
+  char sigma[16] = "-";
+  if (mean_sigma_m > 0)
+    std::snprintf(sigma, sizeof sigma, "%.2f", mean_sigma_m * 100);
+  std::printf(
+      "| %-15s | %-21s | %3.1f | %4zu/%4zu | %5zu | %6.2f | %6.2f | %6.2f | %+6.2f | %7s | %6.1f "
+      "|\n",
+      scenario.name, method, speed, a.fired_once, a.locations,
+      a.fired_more_than_once + a.never_fired, a.mean_abs_m * 100, a.p95_abs_m * 100,
+      a.max_abs_m * 100, a.mean_signed_m * 100, sigma, ms_per_run);
 }
 
 sim::TriggerAccuracy pool(const std::vector<sim::TriggerAccuracy>& runs) {
@@ -100,12 +118,22 @@ sim::TriggerAccuracy pool(const std::vector<sim::TriggerAccuracy>& runs) {
 int run(int argc, char** argv) {
   int seeds = 10;
   double noise = 0.01;
+  double velocity_noise = 0.02;
   double latency = gps::TriggerChainOptions{}.latency_s;
+  gps::TriggerOptions planner;  // the Kalman filter's noise settings can be tried from here
   for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--jerk-density"))
+      planner.kalman_jerk_density = std::atof(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--position-sd"))
+      planner.kalman_position_sd_m = std::atof(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--velocity-sd"))
+      planner.kalman_velocity_sd_mps = std::atof(argv[i + 1]);
     if (!std::strcmp(argv[i], "--seeds"))
       seeds = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--noise"))
       noise = std::atof(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--velocity-noise"))
+      velocity_noise = std::atof(argv[i + 1]);
     if (!std::strcmp(argv[i], "--latency"))
       latency = std::atof(argv[i + 1]);
   }
@@ -114,45 +142,95 @@ int run(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", map.error().message.c_str());
     return 1;
   }
+  // The drives: a tractor breathing ±15 % over 18 s and ±5 % over 5 s; RTK noise white,
+  // or correlated (Gauss-Markov, tau 10 s, instead of white); the receiver-to-host latency
+  // jittering by ±10 ms.
+  const Scenario scenarios[] = {
+      {"constant speed", 0, 0, noise, 0, 0},
+      {"speed changes", 0.15, 0.05, noise, 0, 0},
+      {"+ correlated", 0.15, 0.05, 0, noise, 0},
+      {"+ jitter 10 ms", 0.15, 0.05, noise, 0, 0.010},
+  };
   std::printf(
-      "Trigger accuracy along track: %zu locations x %d seeds per speed, 10 Hz, noise %.1f cm "
-      "per axis, latency %.0f ms, serpentine rows\n\n",
-      map->size(), seeds, noise * 100, latency * 1000);
+      "Trigger accuracy along track: %zu locations x %d seeds per row, 10 Hz, position noise "
+      "%.1f cm per axis (white, or Gauss-Markov tau 10 s in '+ correlated'), velocity noise "
+      "%.1f cm/s per axis, latency %.0f ms, serpentine rows; Kalman jerk density %g m2/s5, "
+      "position SD %g m, velocity SD %g m/s\n\n",
+      map->size(), seeds, noise * 100, velocity_noise * 100, latency * 1000,
+      planner.kalman_jerk_density, planner.kalman_position_sd_m, planner.kalman_velocity_sd_mps);
   std::printf(
-      "| %-28s | m/s | once/total | wrong | mean cm | p95 cm | max cm | bias cm | ms/run |\n",
-      "method");
-  std::printf("|---|---|---|---|---|---|---|---|---|\n");
-  for (double speed : {1.0, 2.0, 3.0}) {
-    std::vector<sim::TriggerAccuracy> predictive, naive;
-    double predictive_ms = 0, naive_ms = 0;
-    for (int seed = 1; seed <= seeds; ++seed) {
-      sim::DriveOptions options;
-      options.speed_mps = speed;
-      options.position_noise_m = noise;
-      options.seed = static_cast<std::uint32_t>(seed);
-      const sim::DriveSimulator drive(fieldPlan(), options);
-      const std::string nmea = drive.nmea();
-      std::vector<core::TriggerEvent> events;
-      gps::TriggerChainOptions replay;
-      replay.latency_s = latency;
-      std::istringstream in(nmea);
-      auto t0 = std::chrono::steady_clock::now();
-      gps::replayTriggers(in, *map, replay,
-                          {[&](const core::TriggerEvent& e) { events.push_back(e); }, {}})
-          .value();
-      auto t1 = std::chrono::steady_clock::now();
-      predictive.push_back(sim::scoreTriggers(drive, *map, events));
-      const auto naive_events = naiveTriggers(nmea, *map, drive.frame());
-      auto t2 = std::chrono::steady_clock::now();
-      naive.push_back(sim::scoreTriggers(drive, *map, naive_events));
-      predictive_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
-      naive_ms += std::chrono::duration<double, std::milli>(t2 - t1).count();
+      "| %-15s | %-21s | m/s | once/total | wrong | mean cm | p95 cm | max cm | bias cm | "
+      "sigma cm | ms/run |\n",
+      "drive", "method");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+  const struct {
+    const char* name;
+    gps::MotionModel model;
+  } models[] = {{"constant-velocity fit", gps::MotionModel::kConstantVelocityFit},
+                {"Kalman (default)", gps::MotionModel::kKalman}};
+  for (const Scenario& scenario : scenarios) {
+    for (double speed : {1.0, 2.0, 3.0}) {
+      std::vector<std::vector<sim::TriggerAccuracy>> runs(std::size(models));
+      std::vector<double> ms(std::size(models), 0), sigma_sum(std::size(models), 0);
+      std::vector<std::size_t> sigma_count(std::size(models), 0);
+      std::vector<sim::TriggerAccuracy> naive;
+      double naive_ms = 0;
+      for (int seed = 1; seed <= seeds; ++seed) {
+        sim::DriveOptions options;
+        options.speed_mps = speed;
+        options.position_noise_m = scenario.white_noise_m;
+        options.correlated_noise_m = scenario.correlated_noise_m;
+        options.correlated_noise_tau_s = 10;
+        options.speed_slow_amplitude = scenario.slow_amplitude;
+        options.speed_slow_period_s = 18;
+        options.speed_fast_amplitude = scenario.fast_amplitude;
+        options.speed_fast_period_s = 5;
+        options.velocity_noise_mps = velocity_noise;
+        options.seed = static_cast<std::uint32_t>(seed);
+        const sim::DriveSimulator drive(fieldPlan(), options);
+        const std::string nmea = drive.nmea();
+        for (std::size_t m = 0; m < std::size(models); ++m) {
+          std::vector<core::TriggerEvent> events;
+          gps::TriggerChainOptions replay;
+          replay.planner = planner;
+          replay.latency_s = latency;
+          replay.latency_jitter_s = scenario.latency_jitter_s;
+          replay.latency_jitter_seed = static_cast<std::uint32_t>(seed);
+          replay.planner.motion_model = models[m].model;
+          std::istringstream in(nmea);
+          const auto t0 = std::chrono::steady_clock::now();
+          gps::replayTriggers(in, *map, replay,
+                              {[&](const core::TriggerEvent& e) { events.push_back(e); }, {}})
+              .value();
+          ms[m] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                       .count();
+          for (const core::TriggerEvent& e : events) {
+            sigma_sum[m] += e.along_track_sigma_m;
+            ++sigma_count[m];
+          }
+          runs[m].push_back(sim::scoreTriggers(drive, *map, events));
+        }
+        if (scenario.slow_amplitude == 0 && scenario.latency_jitter_s == 0) {
+          const auto t0 = std::chrono::steady_clock::now();
+          const auto naive_events = naiveTriggers(nmea, *map, drive.frame());
+          naive_ms +=
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                  .count();
+          naive.push_back(sim::scoreTriggers(drive, *map, naive_events));
+        }
+      }
+      for (std::size_t m = 0; m < std::size(models); ++m) {
+        printRow(scenario, models[m].name, speed, pool(runs[m]),
+                 sigma_count[m] ? sigma_sum[m] / static_cast<double>(sigma_count[m]) : 0,
+                 ms[m] / seeds);
+      }
+      if (!naive.empty())
+        printRow(scenario, "naive: first fix past", speed, pool(naive), 0, naive_ms / seeds);
     }
-    printRow("predictive (TriggerPlanner)", speed, pool(predictive), predictive_ms / seeds);
-    printRow("naive: first fix past", speed, pool(naive), naive_ms / seeds);
   }
   std::printf(
-      "\nwrong = locations fired never or more than once; bias + = fired past the location\n");
+      "\nwrong = locations fired never or more than once; bias + = fired past the location; "
+      "sigma = the planner's own mean 1-sigma estimate of its along-track error\n");
   return 0;
 }
 

@@ -423,19 +423,29 @@ void readSerial(const Value& section, gps::SerialOptions& serial) {
 }
 
 void readPlanner(const Value& section, gps::TriggerOptions& o) {
-  readMap(section, {
-                       {"cross_track_tolerance_m", positive(o.cross_track_tolerance_m, 100)},
-                       {"heading_tolerance_deg", numberIn(o.heading_tolerance_deg, 0, 180)},
-                       {"min_speed_mps", nonNegative(o.min_speed_mps, 50)},
-                       {"max_fix_age_s", positive(o.max_fix_age_s, kMaxWaitS)},
-                       {"max_fix_gap_s", positive(o.max_fix_gap_s, kMaxWaitS)},
-                       {"min_trigger_interval_s", nonNegative(o.min_trigger_interval_s, kMaxWaitS)},
-                       {"late_tolerance_m", nonNegative(o.late_tolerance_m, 100)},
-                       {"rearm_distance_m", nonNegative(o.rearm_distance_m, 1000)},
-                       {"fit_window_s", positive(o.fit_window_s, kMaxWaitS)},
-                       {"fit_residual_limit_m", positive(o.fit_residual_limit_m, 100)},
-                       {"trigger_lead_s", nonNegative(o.trigger_lead_s, kMaxLeadS)},
-                   });
+  readMap(section,
+          {
+              {"cross_track_tolerance_m", positive(o.cross_track_tolerance_m, 100)},
+              {"heading_tolerance_deg", numberIn(o.heading_tolerance_deg, 0, 180)},
+              {"min_speed_mps", nonNegative(o.min_speed_mps, 50)},
+              {"max_fix_age_s", positive(o.max_fix_age_s, kMaxWaitS)},
+              {"max_fix_gap_s", positive(o.max_fix_gap_s, kMaxWaitS)},
+              {"min_trigger_interval_s", nonNegative(o.min_trigger_interval_s, kMaxWaitS)},
+              {"late_tolerance_m", nonNegative(o.late_tolerance_m, 100)},
+              {"rearm_distance_m", nonNegative(o.rearm_distance_m, 1000)},
+              {"fit_window_s", positive(o.fit_window_s, kMaxWaitS)},
+              {"fit_residual_limit_m", positive(o.fit_residual_limit_m, 100)},
+              {"trigger_lead_s", nonNegative(o.trigger_lead_s, kMaxLeadS)},
+              {"motion_model",
+               choice(o.motion_model,
+                      Names<gps::MotionModel>{
+                          {"kalman", gps::MotionModel::kKalman},
+                          {"constant_velocity_fit", gps::MotionModel::kConstantVelocityFit},
+                      })},
+              {"kalman_jerk_density", positive(o.kalman_jerk_density, 1000)},
+              {"kalman_position_sd_m", positive(o.kalman_position_sd_m, 100)},
+              {"kalman_velocity_sd_mps", positive(o.kalman_velocity_sd_mps, 100)},
+          });
 }
 
 void readGps(const Value& section, GpsConfig& gps) {

@@ -619,7 +619,10 @@ class Daemon {
     if (last_trigger_) {
       out["triggers"]["last"] = {{"location", last_trigger_->location_id},
                                  {"time", core::formatIso8601(last_trigger_->time, 3)},
-                                 {"status", core::toString(last_trigger_->status)}};
+                                 {"status", core::toString(last_trigger_->status)},
+                                 // The planner's own 1-sigma uncertainty of this crossing.
+                                 {"timing_sigma_s", last_trigger_->timing_sigma_s},
+                                 {"along_track_sigma_m", last_trigger_->along_track_sigma_m}};
     }
     out["queues"] = {{"in_flight", acquisition_->inFlight()},
                      {"to_record", triggered > stats.sets_recorded + stats.sets_lost

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <Eigen/Core>
+
 namespace fieldrig::gps {
 namespace {
 
@@ -26,6 +28,9 @@ constexpr std::size_t kMinFitSamples = 3;
 constexpr double kMaxMissedSearchM = 30.0;
 // Fixes this far back in time are duplicates or stragglers; further back is a jump in time.
 constexpr double kMaxBackwardStepS = 2.0;
+// A position this many innovation standard deviations (squared, two axes) from the filter's
+// prediction is not noise: chi-square with 2 degrees of freedom exceeds it once in 10^6.
+constexpr double kFilterGateSquared = 27.6;
 // Below this the speed is noise around a standstill: no direction, no crossing time.
 constexpr double kMinPlanningSpeedMps = 0.01;
 constexpr core::Nanoseconds kDecisionTime = std::chrono::microseconds{1};
@@ -51,7 +56,40 @@ struct Track {
   double speed = 0;
   double unit_east = 0, unit_north = 0;  // direction of travel
   double course_deg = 0;
+  double acceleration_along = 0;  // along the direction of travel (0 for the constant-velocity fit)
+  // Per-axis covariance of (position, velocity, acceleration) at t, and the white-jerk density
+  // that widens it with the prediction horizon: the planner's own uncertainty.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double jerk_density = 0;
+
+  // 1-sigma of the along-track position predicted `horizon` seconds after t.
+  double alongSigma(double horizon) const {
+    const Eigen::Vector3d h(1.0, horizon, horizon * horizon / 2);
+    const double h5 = std::pow(horizon, 5);
+    return std::sqrt(std::max(0.0, h.dot(covariance * h) + jerk_density * h5 / 20));
+  }
+
+  // Seconds after t until the antenna has moved `along` metres ahead; nullopt when it stops first.
+  std::optional<double> timeToCover(double along) const {
+    if (acceleration_along == 0)
+      return along / speed;
+    const double discriminant = speed * speed + 2 * acceleration_along * along;
+    if (discriminant < 0)
+      return std::nullopt;
+    // 2·along / (v + √(v² + 2·a·along)): the root of along = v·τ + a·τ²/2 that is stable for
+    // small a and negative along alike.
+    return 2 * along / (speed + std::sqrt(discriminant));
+  }
 };
+
+void setDirection(Track& track) {
+  track.speed = std::hypot(track.velocity_east, track.velocity_north);
+  if (track.speed > 0) {
+    track.unit_east = track.velocity_east / track.speed;
+    track.unit_north = track.velocity_north / track.speed;
+  }
+  track.course_deg = bearingDegrees(track.velocity_east, track.velocity_north);
+}
 
 struct Plan {
   std::size_t target = 0;
@@ -61,6 +99,8 @@ struct Plan {
   double speed = 0;
   double course_deg = 0;
   double cross_track = 0;
+  double timing_sigma = 0;
+  double along_sigma = 0;
   core::UtcTime last_fix_time{};
 };
 
@@ -102,14 +142,115 @@ std::optional<Track> fitTrack(const std::deque<Sample>& samples, std::size_t fir
   track.t = samples.back().t;
   track.east = mean_e + track.velocity_east * (track.t - mean_t);
   track.north = mean_n + track.velocity_north * (track.t - mean_t);
-  track.speed = std::hypot(track.velocity_east, track.velocity_north);
-  if (track.speed > 0) {
-    track.unit_east = track.velocity_east / track.speed;
-    track.unit_north = track.velocity_north / track.speed;
-  }
-  track.course_deg = bearingDegrees(track.velocity_east, track.velocity_north);
+  setDirection(track);
+  // The straight line's own uncertainty, per axis, from its residuals (two axes, two parameters
+  // each): position at t and velocity, correlated through t's distance from the mean time.
+  const double dof = std::max(1.0, 2.0 * static_cast<double>(n) - 4.0);
+  const double variance = sum_squares / dof;
+  const double lever = track.t - mean_t;
+  track.covariance(0, 0) = variance * (1.0 / static_cast<double>(n) + lever * lever / stt);
+  track.covariance(0, 1) = track.covariance(1, 0) = variance * lever / stt;
+  track.covariance(1, 1) = variance / stt;
   return track;
 }
+
+// Kalman filter on (position, velocity, acceleration) per horizontal axis with white-jerk process
+// noise. Both axes see the same measurements with the same noise at the same instants, so they
+// share one covariance matrix: state columns are east and north.
+class MotionFilter {
+ public:
+  MotionFilter(const TriggerOptions& options) : options_(options) {}
+
+  bool initialised() const { return initialised_; }
+  void reset() { initialised_ = false; }
+  double t() const { return t_; }
+
+  // Starts from a straight-line fit (position and velocity at its newest fix), acceleration 0.
+  void initialise(const Track& fit) {
+    t_ = fit.t;
+    state_.setZero();
+    state_(0, 0) = fit.east;
+    state_(0, 1) = fit.north;
+    state_(1, 0) = fit.velocity_east;
+    state_(1, 1) = fit.velocity_north;
+    const double position_variance = options_.kalman_position_sd_m * options_.kalman_position_sd_m;
+    covariance_ = fit.covariance;
+    covariance_(0, 0) = std::max(covariance_(0, 0), position_variance);
+    covariance_(1, 1) = std::max(covariance_(1, 1), position_variance);
+    covariance_(2, 2) = kInitialAccelerationSd * kInitialAccelerationSd;
+    initialised_ = true;
+  }
+
+  void predict(double t) {
+    const double dt = t - t_;
+    if (dt <= 0)
+      return;
+    Eigen::Matrix3d transition;
+    transition << 1, dt, dt * dt / 2, 0, 1, dt, 0, 0, 1;
+    const double q = options_.kalman_jerk_density;
+    const double dt2 = dt * dt, dt3 = dt2 * dt, dt4 = dt3 * dt, dt5 = dt4 * dt;
+    Eigen::Matrix3d process;
+    process << dt5 / 20, dt4 / 8, dt3 / 6, dt4 / 8, dt3 / 3, dt2 / 2, dt3 / 6, dt2 / 2, dt;
+    state_ = transition * state_;
+    covariance_ = transition * covariance_ * transition.transpose() + q * process;
+    t_ = t;
+  }
+
+  // Squared distance of a position from the prediction, in units of its innovation variance.
+  double normalisedInnovation(double east, double north) const {
+    const double variance =
+        covariance_(0, 0) + options_.kalman_position_sd_m * options_.kalman_position_sd_m;
+    const double de = east - state_(0, 0), dn = north - state_(0, 1);
+    return (de * de + dn * dn) / variance;
+  }
+
+  // Distance of a position from the prediction, metres.
+  double innovation(double east, double north) const {
+    return std::hypot(east - state_(0, 0), north - state_(0, 1));
+  }
+
+  void updatePosition(double east, double north) {
+    update(0, east, north, options_.kalman_position_sd_m);
+  }
+  void updateVelocity(double east, double north) {
+    update(1, east, north, options_.kalman_velocity_sd_mps);
+  }
+
+  Track track() const {
+    Track track;
+    track.t = t_;
+    track.east = state_(0, 0);
+    track.north = state_(0, 1);
+    track.velocity_east = state_(1, 0);
+    track.velocity_north = state_(1, 1);
+    setDirection(track);
+    track.acceleration_along = state_(2, 0) * track.unit_east + state_(2, 1) * track.unit_north;
+    track.covariance = covariance_;
+    track.jerk_density = options_.kalman_jerk_density;
+    return track;
+  }
+
+ private:
+  // Tractors change speed by tenths of m/s², turns aside.
+  static constexpr double kInitialAccelerationSd = 0.5;
+
+  // Scalar update of state row `row` (position or velocity) on both axes.
+  void update(int row, double east, double north, double sd) {
+    const double innovation_variance = covariance_(row, row) + sd * sd;
+    const Eigen::Vector3d gain = covariance_.col(row) / innovation_variance;
+    const double de = east - state_(row, 0), dn = north - state_(row, 1);
+    state_.col(0) += gain * de;
+    state_.col(1) += gain * dn;
+    covariance_ -= gain * covariance_.row(row);
+    covariance_ = (covariance_ + covariance_.transpose()) / 2;  // keep it symmetric
+  }
+
+  const TriggerOptions& options_;
+  bool initialised_ = false;
+  double t_ = 0;
+  Eigen::Matrix<double, 3, 2> state_ = Eigen::Matrix<double, 3, 2>::Zero();
+  Eigen::Matrix3d covariance_ = Eigen::Matrix3d::Zero();
+};
 
 }  // namespace
 
@@ -118,7 +259,8 @@ struct TriggerPlanner::State {
       : map(location_map),
         options(planner_options),
         frame(location_map.locations().front().latitude_deg,
-              location_map.locations().front().longitude_deg) {}
+              location_map.locations().front().longitude_deg),
+        filter(options) {}
 
   const LocationMap& map;
   TriggerOptions options;
@@ -131,6 +273,7 @@ struct TriggerPlanner::State {
   std::optional<core::UtcTime> last_fix_time;
   std::optional<core::GpsFix> last_valid_fix;  // carried by the events planned on it
   std::deque<Sample> samples;
+  MotionFilter filter;  // references `options`: State is never copied or moved
   std::optional<Track> track;
   std::optional<EnuPoint> last_planned_position;  // the track's position at the last plan
   std::vector<Plan> plans;                        // sorted by time
@@ -148,6 +291,7 @@ struct TriggerPlanner::State {
     if (!samples.empty())
       ++stats.track_restarts;
     samples.clear();
+    filter.reset();
     track.reset();
     plans.clear();
   }
@@ -190,6 +334,45 @@ struct TriggerPlanner::State {
       if (samples.size() - first < kMinFitSamples)
         first = samples.size() - kMinFitSamples;
     }
+  }
+
+  // The Kalman track after the newest sample (and the fix's reported velocity, if any).
+  void filterTrack(const core::GpsFix& fix) {
+    track.reset();
+    const Sample& newest = samples.back();
+    if (filter.initialised()) {
+      filter.predict(newest.t);
+      // A fix far outside the prediction (a tight turn, a jump of the receiver's solution): the
+      // motion is not what the filter models; start again from the fixes that follow.
+      if (filter.normalisedInnovation(newest.east, newest.north) > kFilterGateSquared &&
+          filter.innovation(newest.east, newest.north) > options.fit_residual_limit_m) {
+        ++stats.filter_resets;
+        filter.reset();
+        samples.erase(samples.begin(), samples.end() - 1);
+      }
+    }
+    if (!filter.initialised()) {
+      // Started from a straight line through the recent fixes; the oldest give way until it
+      // fits them (the one bad fix that reset the filter, the turn before the row).
+      while (samples.size() >= kMinFitSamples) {
+        double rms = 0;
+        const std::optional<Track> fit = fitTrack(samples, 0, &rms);
+        if (fit && rms <= options.fit_residual_limit_m) {
+          filter.initialise(*fit);
+          break;
+        }
+        samples.pop_front();
+      }
+      if (!filter.initialised())
+        return;
+    } else {
+      filter.updatePosition(newest.east, newest.north);
+    }
+    if (fix.speed_mps && fix.course_deg) {
+      const double course = *fix.course_deg / kDegreesPerRadian;
+      filter.updateVelocity(*fix.speed_mps * std::sin(course), *fix.speed_mps * std::cos(course));
+    }
+    track = filter.track();
   }
 
   void plan(core::UtcTime now, double unplanned_distance) {
@@ -240,9 +423,14 @@ struct TriggerPlanner::State {
         }
         continue;
       }
+      const std::optional<double> horizon = tr.timeToCover(along);
+      if (!horizon)
+        continue;  // slowing to a stop before the location: no crossing to plan yet
       Plan p;
       p.target = i;
-      p.predicted = timeAt(tr.t + along / tr.speed - options.trigger_lead_s);
+      p.predicted = timeAt(tr.t + *horizon - options.trigger_lead_s);
+      p.along_sigma = tr.alongSigma(std::max(0.0, *horizon));
+      p.timing_sigma = p.along_sigma / tr.speed;
       p.time = p.predicted;
       if (p.time < now) {
         p.time = now;  // noticed after the moment: fire at once, flagged
@@ -262,6 +450,10 @@ struct TriggerPlanner::State {
 
   std::vector<IndexEntry> candidates;  // reused across queries
 };
+
+std::string_view toString(MotionModel model) {
+  return model == MotionModel::kKalman ? "kalman" : "constant_velocity_fit";
+}
 
 std::string_view toString(AlarmKind kind) {
   return kind == AlarmKind::kTooFast ? "too_fast" : "missed";
@@ -339,7 +531,10 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
          t - s.samples.front().t > s.options.fit_window_s + 1e-6) {
     s.samples.pop_front();
   }
-  s.fitAdaptively();
+  if (s.options.motion_model == MotionModel::kKalman)
+    s.filterTrack(fix);
+  else
+    s.fitAdaptively();
   if (!s.track) {
     s.plans.clear();
     return;
@@ -414,10 +609,14 @@ std::vector<core::TriggerEvent> TriggerPlanner::collectDue(core::UtcTime now) {
     event.speed_mps = p.speed;
     event.course_deg = p.course_deg;
     event.cross_track_m = p.cross_track;
+    event.timing_sigma_s = p.timing_sigma;
+    event.along_track_sigma_m = p.along_sigma;
     event.last_fix_time = p.last_fix_time;
     if (s.last_valid_fix && s.last_valid_fix->time == p.last_fix_time)
       event.fix = s.last_valid_fix;
     ++s.stats.triggers;
+    s.stats.last_timing_sigma_s = p.timing_sigma;
+    s.stats.last_along_track_sigma_m = p.along_sigma;
     if (p.status == core::TriggerStatus::kLate)
       ++s.stats.triggers_late;
     s.last_trigger_time = fire_at;

@@ -1,7 +1,9 @@
 #include "fieldrig/gps/trigger_replay.h"
 
 #include <array>
+#include <cmath>
 #include <optional>
+#include <random>
 #include <vector>
 
 #include "fieldrig/gps/fix_assembler.h"
@@ -11,6 +13,12 @@ namespace fieldrig::gps {
 core::Result<ReplaySummary> replayTriggers(std::istream& nmea, const LocationMap& map,
                                            const TriggerChainOptions& options,
                                            const ReplayHandlers& handlers) {
+  if (!std::isfinite(options.latency_jitter_s) || options.latency_jitter_s < 0 ||
+      options.latency_jitter_s > options.latency_s) {
+    return core::Error{
+        "latency_jitter_s: " + std::to_string(options.latency_jitter_s) +
+        " s must be finite and in [0, latency_s = " + std::to_string(options.latency_s) + " s]"};
+  }
   core::Result<TriggerPlanner> created = TriggerPlanner::create(map, options.planner);
   if (!created)
     return created.error();
@@ -18,6 +26,9 @@ core::Result<ReplaySummary> replayTriggers(std::istream& nmea, const LocationMap
   FixAssembler assembler;
   const core::Nanoseconds latency = core::fromSeconds(options.latency_s);
   std::optional<core::UtcTime> last_available;
+  std::mt19937_64 jitter_random(options.latency_jitter_seed);
+  std::uniform_real_distribution<double> jitter(-options.latency_jitter_s,
+                                                options.latency_jitter_s);
 
   auto publish = [&](core::UtcTime until) {
     for (const core::TriggerEvent& event : planner.collectDue(until)) {
@@ -36,7 +47,12 @@ core::Result<ReplaySummary> replayTriggers(std::istream& nmea, const LocationMap
         const std::optional<core::GpsFix> fix = assembler.add(sentence, core::ReceptionStamp{});
         if (!fix)
           return;
-        const core::UtcTime available = fix->time + latency;
+        core::UtcTime available = fix->time + latency;
+        if (options.latency_jitter_s > 0) {
+          // Never before the fix itself (a jitter of the whole latency would make it instant).
+          available = std::max(fix->time + core::Nanoseconds{1},
+                               available + core::fromSeconds(jitter(jitter_random)));
+        }
         // Everything planned before this fix could be used fires first: causality.
         publish(available - core::Nanoseconds{1});
         planner.addFix(*fix, available);

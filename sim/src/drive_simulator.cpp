@@ -61,13 +61,57 @@ gps::EnuPoint add(const gps::EnuPoint& p, double e, double n) {
   return {p.east_m + e, p.north_m + n};
 }
 
+// The speed profile's phases and the extra noise streams come from their own generators, so that
+// drives without them keep the white-noise stream they always had.
+constexpr std::uint64_t kPhaseStream = 0x9e3779b97f4a7c15;
+constexpr std::uint64_t kCorrelatedStream = 0xbf58476d1ce4e5b9;
+constexpr std::uint64_t kVelocityStream = 0x94d049bb133111eb;
+
+core::Result<void> checkRange(const char* name, double value, double min, double max) {
+  if (!std::isfinite(value) || value < min || value > max) {
+    return core::Error{std::string("drive option ") + name + ": " + std::to_string(value) +
+                       " is not a finite number in [" + std::to_string(min) + ", " +
+                       std::to_string(max) + "]"};
+  }
+  return {};
+}
+
 }  // namespace
+
+core::Result<void> validate(const DriveOptions& o) {
+  const struct {
+    const char* name;
+    double value, min, max;
+  } checks[] = {
+      {"speed_mps", o.speed_mps, 0.1, 30},
+      {"rate_hz", o.rate_hz, 0.1, 100},
+      {"position_noise_m", o.position_noise_m, 0, 100},
+      {"headland_m", o.headland_m, 0, 1000},
+      {"speed_slow_amplitude", o.speed_slow_amplitude, 0, 0.5},
+      {"speed_slow_period_s", o.speed_slow_period_s, 0.5, 3600},
+      {"speed_fast_amplitude", o.speed_fast_amplitude, 0, 0.5},
+      {"speed_fast_period_s", o.speed_fast_period_s, 0.5, 3600},
+      {"velocity_noise_mps", o.velocity_noise_mps, 0, 10},
+      {"correlated_noise_m", o.correlated_noise_m, 0, 100},
+      {"correlated_noise_tau_s", o.correlated_noise_tau_s, 0.01, 3600},
+  };
+  for (const auto& check : checks) {
+    if (auto ok = checkRange(check.name, check.value, check.min, check.max); !ok)
+      return ok;
+  }
+  return {};
+}
 
 DriveSimulator::DriveSimulator(const gps::FieldPlan& plan, DriveOptions options)
     : options_(std::move(options)),
       frame_(plan.row_start_latitude_deg, plan.row_start_longitude_deg) {
-  if (options_.speed_mps <= 0 || options_.rate_hz <= 0) {
-    throw std::invalid_argument("drive speed and rate must be positive");
+  if (const auto valid = validate(options_); !valid)
+    throw std::invalid_argument(valid.error().message);
+  {
+    std::mt19937_64 phases(options_.seed ^ kPhaseStream);
+    std::uniform_real_distribution<double> angle(0.0, 2 * kPi);
+    slow_phase_ = angle(phases);
+    fast_phase_ = angle(phases);
   }
   const gps::EnuPoint start{0, 0};
   const gps::EnuPoint end = frame_.toLocal(plan.row_end_latitude_deg, plan.row_end_longitude_deg);
@@ -113,10 +157,38 @@ DriveSimulator::DriveSimulator(const gps::FieldPlan& plan, DriveOptions options)
     length_m_ += arc.length;
     segments_.push_back(arc);
   }
+  // The distance grows monotonically (the speed never falls below half the mean): bisect for the
+  // moment it reaches the drive's length.
+  const double mean_duration = length_m_ / options_.speed_mps;
+  double low = 0, high = 2 * mean_duration + 1;
+  for (int i = 0; i < 100 && high - low > 1e-9; ++i) {
+    const double mid = (low + high) / 2;
+    (distanceAt(mid) < length_m_ ? low : high) = mid;
+  }
+  end_ = options_.start + core::fromSeconds(high);
 }
 
-core::UtcTime DriveSimulator::end() const {
-  return options_.start + core::fromSeconds(length_m_ / options_.speed_mps);
+double DriveSimulator::distanceAt(double t) const {
+  // The integral of the speed profile from 0 to t.
+  auto breathing = [t](double amplitude, double period, double phase) {
+    if (amplitude == 0)
+      return 0.0;
+    const double omega = 2 * kPi / period;
+    return amplitude / omega * (std::cos(phase) - std::cos(omega * t + phase));
+  };
+  return options_.speed_mps *
+         (t + breathing(options_.speed_slow_amplitude, options_.speed_slow_period_s, slow_phase_) +
+          breathing(options_.speed_fast_amplitude, options_.speed_fast_period_s, fast_phase_));
+}
+
+double DriveSimulator::speedAt(core::UtcTime time) const {
+  const double t = core::toSeconds(time - options_.start);
+  return options_.speed_mps *
+         (1 +
+          options_.speed_slow_amplitude *
+              std::sin(2 * kPi * t / options_.speed_slow_period_s + slow_phase_) +
+          options_.speed_fast_amplitude *
+              std::sin(2 * kPi * t / options_.speed_fast_period_s + fast_phase_));
 }
 
 TruePose DriveSimulator::poseAtDistance(double s) const {
@@ -143,7 +215,7 @@ TruePose DriveSimulator::poseAtDistance(double s) const {
 }
 
 TruePose DriveSimulator::poseAt(core::UtcTime t) const {
-  return poseAtDistance(core::toSeconds(t - options_.start) * options_.speed_mps);
+  return poseAtDistance(distanceAt(core::toSeconds(t - options_.start)));
 }
 
 double DriveSimulator::alongTrackError(core::UtcTime fired, double latitude_deg,
@@ -157,21 +229,48 @@ double DriveSimulator::alongTrackError(core::UtcTime fired, double latitude_deg,
 std::string DriveSimulator::nmea() const {
   std::mt19937_64 random(options_.seed);
   std::normal_distribution<double> noise(0.0, options_.position_noise_m);
+  std::mt19937_64 correlated_random(options_.seed ^ kCorrelatedStream);
+  std::mt19937_64 velocity_random(options_.seed ^ kVelocityStream);
+  std::normal_distribution<double> unit(0.0, 1.0);
   const auto period = core::fromSeconds(1.0 / options_.rate_hz);
+  // First-order Gauss–Markov: x(k+1) = φ·x(k) + σ·√(1−φ²)·w, stationary from the first epoch.
+  const double sigma = options_.correlated_noise_m;
+  const double phi = std::exp(-core::toSeconds(period) / options_.correlated_noise_tau_s);
+  double correlated_east = 0, correlated_north = 0;
+  if (sigma > 0) {
+    correlated_east = sigma * unit(correlated_random);
+    correlated_north = sigma * unit(correlated_random);
+  }
   std::string out;
   for (core::UtcTime epoch = options_.start; epoch <= end(); epoch += period) {
     // The sentences carry centiseconds: the position is the one at the time they state.
     const core::UtcTime t =
         std::chrono::floor<std::chrono::duration<std::int64_t, std::centi>>(epoch);
     const TruePose pose = poseAt(t);
-    const gps::GeodeticPoint geo =
-        frame_.toGeodetic(add(pose.position, noise(random), noise(random)));
+    if (sigma > 0 && epoch != options_.start) {
+      const double step = sigma * std::sqrt(1 - phi * phi);
+      correlated_east = phi * correlated_east + step * unit(correlated_random);
+      correlated_north = phi * correlated_north + step * unit(correlated_random);
+    }
+    // North is drawn first: the order GCC evaluated the draws in when they were two arguments of
+    // one call, which the bundled demo drive (sim/data) was made with.
+    const double white_north = noise(random);
+    const double white_east = noise(random);
+    const double noise_east = white_east + correlated_east;
+    const double noise_north = white_north + correlated_north;
+    const gps::GeodeticPoint geo = frame_.toGeodetic(add(pose.position, noise_east, noise_north));
+    double velocity_east = speedAt(t) * pose.unit_east;
+    double velocity_north = speedAt(t) * pose.unit_north;
+    if (options_.velocity_noise_mps > 0) {
+      velocity_east += options_.velocity_noise_mps * unit(velocity_random);
+      velocity_north += options_.velocity_noise_mps * unit(velocity_random);
+    }
     const std::string lat = coordinateText(geo.latitude_deg, 2, 'N', 'S');
     const std::string lon = coordinateText(geo.longitude_deg, 3, 'E', 'W');
     char numbers[64];
     std::snprintf(numbers, sizeof numbers, "%.3f,%.2f",
-                  options_.speed_mps * kKnotsPerMetrePerSecond,
-                  gps::bearingDegrees(pose.unit_east, pose.unit_north));
+                  std::hypot(velocity_east, velocity_north) * kKnotsPerMetrePerSecond,
+                  gps::bearingDegrees(velocity_east, velocity_north));
     out += gps::withChecksum(options_.talker + "RMC," + timeText(t) + ",A," + lat + "," + lon +
                              "," + numbers + "," + dateText(t) + ",,,R") +
            "\r\n";

@@ -58,6 +58,10 @@ void expectSame(const gps::TriggerChainOptions& actual, const gps::TriggerChainO
   EXPECT_FIELD(planner.fit_window_s);
   EXPECT_FIELD(planner.fit_residual_limit_m);
   EXPECT_FIELD(planner.trigger_lead_s);
+  EXPECT_FIELD(planner.motion_model);
+  EXPECT_FIELD(planner.kalman_jerk_density);
+  EXPECT_FIELD(planner.kalman_position_sd_m);
+  EXPECT_FIELD(planner.kalman_velocity_sd_mps);
 }
 
 void expectSame(const drivers::CameraConfig& actual, const drivers::CameraConfig& expected) {
@@ -629,6 +633,10 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
       "    fit_window_s: 1.5\n"
       "    fit_residual_limit_m: 0.04\n"
       "    trigger_lead_s: 0.01\n"
+      "    motion_model: constant_velocity_fit\n"
+      "    kalman_jerk_density: 0.25\n"
+      "    kalman_position_sd_m: 0.02\n"
+      "    kalman_velocity_sd_mps: 0.03\n"
       "recording: {dir: /rec, fsync: per_frame}\n"
       "pipeline:\n"
       "  enabled: false\n"
@@ -678,6 +686,10 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
   triggers.planner.fit_window_s = 1.5;
   triggers.planner.fit_residual_limit_m = 0.04;
   triggers.planner.trigger_lead_s = 0.01;
+  triggers.planner.motion_model = gps::MotionModel::kConstantVelocityFit;
+  triggers.planner.kalman_jerk_density = 0.25;
+  triggers.planner.kalman_position_sd_m = 0.02;
+  triggers.planner.kalman_velocity_sd_mps = 0.03;
   expectSame(c.gps.triggers, triggers);
   EXPECT_EQ(c.recording.dir, fs::path("/rec"));
   EXPECT_EQ(c.recording.writer.fsync, recording::FsyncPolicy::kPerFrame);

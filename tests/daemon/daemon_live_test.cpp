@@ -159,6 +159,14 @@ TEST(DaemonLive, GpsLossAndSerialUnplugAreAlarmedSurvivedAndRecovered) {
   EXPECT_LT(lost_after_s, 1.5);
   EXPECT_FALSE(final_status.at("gps").at("lost").get<bool>()) << final_status.dump();
   EXPECT_EQ(final_status.at("gps").at("serial"), "opened") << final_status.dump();
+  // The planner's own uncertainty of its latest crossing: more than nothing (1 cm of simulated
+  // noise), less than a plot's worth, and the two sigmas agree through the speed (2 m/s).
+  const Json last = final_status.at("triggers").at("last");
+  const double timing_sigma = last.at("timing_sigma_s").get<double>();
+  const double along_sigma = last.at("along_track_sigma_m").get<double>();
+  EXPECT_GT(along_sigma, 0.001) << last.dump();
+  EXPECT_LT(along_sigma, 0.05) << last.dump();
+  EXPECT_NEAR(timing_sigma * 2.0, along_sigma, along_sigma * 0.3) << last.dump();
   ASSERT_TRUE(daemon.signal(SIGTERM));
   ASSERT_EQ(daemon.waitExit(30s), 0) << daemon.err();
 

@@ -406,6 +406,80 @@ TEST(TriggerPlannerTest, SeasonSizedMapOnlyFiresTheLocationsDriven) {
   }
 }
 
+// Accelerating due north from 1 m/s at 0.3 m/s² (noise-free, speed and course reported): each
+// location's true crossing time solves north(t) = location. Returns |along-track error| of each
+// trigger, metres, in location order.
+std::vector<double> acceleratingErrors(MotionModel model, std::size_t* triggers) {
+  Field field;
+  for (int i = 0; i < 6; ++i)
+    field.addLocation("P" + std::to_string(i), 0.0, 4.0 + 2.5 * i);
+  TriggerOptions options;
+  options.motion_model = model;
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), options).value();
+  constexpr double kV0 = 1.0, kA = 0.3, kNorth0 = -2.0;
+  auto northAt = [](double t) { return kNorth0 + kV0 * t + kA * t * t / 2; };
+  std::vector<core::TriggerEvent> events;
+  for (int k = 0; k <= 100; ++k) {
+    const core::UtcTime t = kStart + k * 100ms;
+    for (auto& e : planner.collectDue(t - 1ns))
+      events.push_back(e);
+    core::GpsFix fix = field.fixAt(t, 0.0, northAt(0.1 * k));
+    fix.speed_mps = kV0 + kA * 0.1 * k;
+    fix.course_deg = 0.0;
+    planner.addFix(fix, t);
+    for (auto& e : planner.collectDue(t))
+      events.push_back(e);
+  }
+  *triggers = events.size();
+  std::vector<double> errors;
+  for (const auto& e : events)
+    errors.push_back(std::abs(northAt(core::toSeconds(e.time - kStart)) -
+                              (4.0 + 2.5 * std::stoi(e.location_id.substr(1)))));
+  return errors;
+}
+
+TEST(TriggerPlannerTest, KalmanFollowsAccelerationThatTheStraightLineLags) {
+  std::size_t kalman_triggers = 0, line_triggers = 0;
+  const auto kalman = acceleratingErrors(MotionModel::kKalman, &kalman_triggers);
+  const auto line = acceleratingErrors(MotionModel::kConstantVelocityFit, &line_triggers);
+  ASSERT_EQ(kalman_triggers, 6u);
+  ASSERT_EQ(line_triggers, 6u);
+  // The first location comes 2 s in, while the filter still learns the acceleration; from the
+  // second on it is tracked to a millimetre. The straight line through the last second of fixes
+  // lags by a·T²/12 ≈ 2.5 cm at every one.
+  for (std::size_t i = 1; i < kalman.size(); ++i) {
+    EXPECT_LT(kalman[i], 0.002) << "location " << i;
+    EXPECT_GT(line[i], 0.01) << "location " << i;
+  }
+}
+
+TEST(TriggerPlannerTest, FixFarOffThePredictionRestartsTheFilter) {
+  Field field;
+  field.addLocation("before", 0.0, 3.0);
+  field.addLocation("after", 0.0, 7.0);  // crossed 1 s after the jump
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
+  Drive d;
+  d.duration_s = 14;  // north -10 … 18 m
+  // The receiver's solution jumps 0.5 m east for one epoch at 5 m north (a bad fix).
+  std::vector<core::TriggerEvent> events;
+  for (int k = 0; k <= 140; ++k) {
+    const core::UtcTime t = kStart + k * 100ms;
+    for (auto& e : planner.collectDue(t - 1ns))
+      events.push_back(e);
+    const double north = -10 + 0.2 * k;
+    planner.addFix(field.fixAt(t, k == 75 ? 0.5 : 0.0, north), t);
+    for (auto& e : planner.collectDue(t))
+      events.push_back(e);
+  }
+  // The jump is far off what the filter predicted: it restarts, from the three good fixes after
+  // the jump (the bad one dropped), in time for the next location.
+  EXPECT_GE(planner.stats().filter_resets, 1u);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[1].location_id, "after");
+  EXPECT_EQ(events[1].status, core::TriggerStatus::kOnTime);
+  EXPECT_NEAR(crossingNorth(events[1], d), 7.0, 1e-3);
+}
+
 TEST(TriggerPlannerTest, EmptyMapIsAStartUpError) {
   LocationMap empty;
   const auto planner = TriggerPlanner::create(empty, {});

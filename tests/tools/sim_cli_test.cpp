@@ -55,5 +55,74 @@ TEST_F(SimCliTest, BadRowEndIsAnErrorNamingTheOption) {
   EXPECT_FALSE(fs::exists(dir_ / "drive.nmea"));
 }
 
+// The speed profile, correlated noise and velocity noise reach the NMEA: RMC speeds breathe
+// around the mean.
+TEST_F(SimCliTest, BreathingDriveReportsTheChangingSpeed) {
+  const gps::FieldPlan plan =
+      testing_support::fieldPlan({42.0106, -93.7385}, {42.0112, -93.7385}, 2, 3.0, 1.0);
+  const auto run = runFieldrig(withFieldPlan({"sim", "drive"}, plan,
+                                             {"--speed",
+                                              "2",
+                                              "--speed-slow-amplitude",
+                                              "0.15",
+                                              "--speed-slow-period",
+                                              "18",
+                                              "--speed-fast-amplitude",
+                                              "0.05",
+                                              "--speed-fast-period",
+                                              "5",
+                                              "--correlated-noise",
+                                              "0.01",
+                                              "--correlated-noise-tau",
+                                              "10",
+                                              "--velocity-noise",
+                                              "0.02",
+                                              "--out-nmea",
+                                              (dir_ / "drive.nmea").string(),
+                                              "--out-map",
+                                              (dir_ / "map.csv").string()}),
+                               dir_);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string nmea = readWholeFile(dir_ / "drive.nmea");
+  double slowest = 1e9, fastest = 0;
+  for (std::size_t at = nmea.find("RMC,"); at != std::string::npos;
+       at = nmea.find("RMC,", at + 1)) {
+    // $GNRMC,time,A,lat,N,lon,W,knots,...: the speed is the 7th field after "RMC".
+    std::size_t field = at;
+    for (int i = 0; i < 7; ++i)
+      field = nmea.find(',', field) + 1;
+    const double mps = std::stod(nmea.substr(field)) * 1852.0 / 3600.0;
+    slowest = std::min(slowest, mps);
+    fastest = std::max(fastest, mps);
+  }
+  EXPECT_LT(slowest, 1.85);
+  EXPECT_GT(fastest, 2.15);
+  EXPECT_GT(slowest, 1.5);
+  EXPECT_LT(fastest, 2.5);
+}
+
+TEST_F(SimCliTest, BadDriveOptionsAreErrorsNamingTheOption) {
+  const gps::FieldPlan plan =
+      testing_support::fieldPlan({42.0106, -93.7385}, {42.0112, -93.7385}, 2, 3.0, 1.0);
+  const struct {
+    std::string option, value;
+  } cases[] = {
+      {"--speed-slow-amplitude", "0.7"}, {"--speed-fast-amplitude", "-0.1"},
+      {"--speed-slow-period", "nan"},    {"--speed-fast-period", "0"},
+      {"--correlated-noise", "inf"},     {"--correlated-noise-tau", "0"},
+      {"--velocity-noise", "-1"},
+  };
+  for (const auto& c : cases) {
+    const auto run =
+        runFieldrig(withFieldPlan({"sim", "drive"}, plan,
+                                  {c.option, c.value, "--out-nmea", (dir_ / "drive.nmea").string(),
+                                   "--out-map", (dir_ / "map.csv").string()}),
+                    dir_);
+    EXPECT_EQ(run.exit_code, 2) << c.option << " " << c.value;
+    EXPECT_NE(run.err.find(c.option), std::string::npos) << run.err;
+    EXPECT_FALSE(fs::exists(dir_ / "drive.nmea")) << c.option;
+  }
+}
+
 }  // namespace
 }  // namespace fieldrig

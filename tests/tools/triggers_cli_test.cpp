@@ -83,6 +83,59 @@ TEST_F(TriggersCliTest, PrintsOneJsonLinePerTriggerWithLocationAndIsoTime) {
   EXPECT_EQ(summary["summary"]["missed"], 0);
 }
 
+// A drive breathing ±15 % replayed with ±10 ms of latency jitter, by both motion models: every
+// location once, causal, and each trigger says its own uncertainty.
+TEST_F(TriggersCliTest, JitteredReplayOfABreathingDriveWithEitherMotionModel) {
+  sim::DriveOptions options;
+  options.speed_slow_amplitude = 0.15;
+  options.speed_fast_amplitude = 0.05;
+  options.velocity_noise_mps = 0.02;
+  const sim::DriveSimulator drive(plan_, options);
+  write(dir_ / "drive.nmea", drive.nmea());
+  for (const char* model : {"kalman", "constant_velocity_fit"}) {
+    const auto run = runFieldrig(
+        {"triggers", "--map", (dir_ / "map.csv").string(), "--nmea", (dir_ / "drive.nmea").string(),
+         "--latency-jitter", "0.01", "--motion-model", model},
+        dir_);
+    ASSERT_EQ(run.exit_code, 0) << model << ": " << run.err;
+    ASSERT_EQ(run.out_lines.size(), map_.size()) << model;
+    for (const std::string& text : run.out_lines) {
+      const Json line = Json::parse(text);
+      const auto time = core::parseIso8601(line["time"].get<std::string>());
+      const auto last_fix = core::parseIso8601(line["last_fix_time"].get<std::string>());
+      ASSERT_TRUE(time && last_fix);
+      EXPECT_LT(*last_fix, *time) << model;
+      EXPECT_GT(line["along_track_sigma_m"].get<double>(), 0.0) << model;
+      EXPECT_GT(line["timing_sigma_s"].get<double>(), 0.0) << model;
+    }
+  }
+}
+
+TEST_F(TriggersCliTest, BadJitterAndMotionModelAreErrorsNamingTheOption) {
+  const sim::DriveSimulator drive(plan_, sim::DriveOptions{});
+  write(dir_ / "drive.nmea", drive.nmea());
+  const std::vector<std::string> base = {"triggers", "--map", (dir_ / "map.csv").string(), "--nmea",
+                                         (dir_ / "drive.nmea").string()};
+  const struct {
+    std::vector<std::string> extra;
+    std::string named;
+  } cases[] = {
+      {{"--latency-jitter", "nan"}, "--latency-jitter"},
+      {{"--latency-jitter", "-0.01"}, "--latency-jitter"},
+      // Within the option's own range but more than the latency itself.
+      {{"--latency", "0.02", "--latency-jitter", "0.03"}, "latency_jitter_s"},
+      {{"--motion-model", "magic"}, "--motion-model"},
+  };
+  for (const auto& c : cases) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), c.extra.begin(), c.extra.end());
+    const auto run = runFieldrig(args, dir_);
+    EXPECT_NE(run.exit_code, 0) << c.extra.back();
+    EXPECT_NE(run.err.find(c.named), std::string::npos) << run.err;
+    EXPECT_TRUE(run.out_lines.empty()) << c.extra.back();
+  }
+}
+
 TEST_F(TriggersCliTest, InvalidFixesYieldNoTriggers) {
   sim::DriveOptions options;
   const sim::DriveSimulator drive(plan_, options);

@@ -40,6 +40,10 @@ int runDrive(const DriveArgs& args) {
   const auto map = gps::generateLocations(*plan);
   if (!map)
     return fail(kName, map.error().message);
+  // Each option was range-checked on its own; this also names the option of a value built from
+  // several (and keeps the simulator's own rules in one place).
+  if (const auto valid = sim::validate(options); !valid)
+    return fail(kName, valid.error().message);
   const sim::DriveSimulator drive(*plan, options);
   std::ofstream nmea(args.out_nmea, std::ios::binary);
   nmea << drive.nmea();
@@ -81,6 +85,37 @@ void registerSimCommand(CLI::App& app, int& exit_code) {
   drive->add_option("--headland", d.headland_m, "Straight run-in/out beyond each row end, m")
       ->capture_default_str()
       ->check(finiteRange(0.0, 1000.0));
+  drive
+      ->add_option("--speed-slow-amplitude", d.speed_slow_amplitude,
+                   "Slow speed breathing: amplitude as a fraction of --speed (0.15 = ±15 %)")
+      ->capture_default_str()
+      ->check(finiteRange(0.0, 0.5));
+  drive->add_option("--speed-slow-period", d.speed_slow_period_s, "Slow speed breathing: period, s")
+      ->capture_default_str()
+      ->check(finiteRange(0.5, 3600.0));
+  drive
+      ->add_option("--speed-fast-amplitude", d.speed_fast_amplitude,
+                   "Fast speed breathing: amplitude as a fraction of --speed")
+      ->capture_default_str()
+      ->check(finiteRange(0.0, 0.5));
+  drive->add_option("--speed-fast-period", d.speed_fast_period_s, "Fast speed breathing: period, s")
+      ->capture_default_str()
+      ->check(finiteRange(0.5, 3600.0));
+  drive
+      ->add_option("--velocity-noise", d.velocity_noise_mps,
+                   "Noise (SD per axis) of the velocity behind RMC speed and course, m/s")
+      ->capture_default_str()
+      ->check(finiteRange(0.0, 10.0));
+  drive
+      ->add_option("--correlated-noise", d.correlated_noise_m,
+                   "Gauss-Markov position noise (SD per axis), m")
+      ->capture_default_str()
+      ->check(finiteRange(0.0, 100.0));
+  drive
+      ->add_option("--correlated-noise-tau", d.correlated_noise_tau_s,
+                   "Gauss-Markov position noise: correlation time, s")
+      ->capture_default_str()
+      ->check(finiteRange(0.01, 3600.0));
   drive->add_option("--seed", d.seed, "Noise seed")->capture_default_str();
   drive->add_option("--talker", d.talker, "NMEA talker id")->capture_default_str();
   drive->add_option("--start", args->start, "GPS time of the first fix (ISO-8601 UTC)");

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -36,6 +37,8 @@ Json triggerJson(const core::TriggerEvent& event) {
   line["speed_mps"] = event.speed_mps;
   line["course_deg"] = event.course_deg;
   line["cross_track_m"] = event.cross_track_m;
+  line["timing_sigma_s"] = event.timing_sigma_s;
+  line["along_track_sigma_m"] = event.along_track_sigma_m;
   return line;
 }
 
@@ -58,6 +61,7 @@ Json summaryJson(const gps::LocationMap& map, const gps::NmeaStats& nmea,
   out["fixes_invalid"] = s.fixes_invalid;
   out["fixes_too_slow"] = s.fixes_too_slow;
   out["track_restarts"] = s.track_restarts;
+  out["filter_resets"] = s.filter_resets;
   out["triggers"] = s.triggers;
   out["triggers_late"] = s.triggers_late;
   out["missed"] = s.missed;
@@ -148,6 +152,19 @@ void registerTriggersCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--latency", args->replay.latency_s, "receiver and serial latency, seconds")
       ->capture_default_str()
       ->check(finiteRange(0.0, 1.0));
+  cmd->add_option("--latency-jitter", args->replay.latency_jitter_s,
+                  "replay: vary each fix's latency uniformly by ± this many seconds (≤ --latency)")
+      ->capture_default_str()
+      ->check(finiteRange(0.0, 1.0));
+  cmd->add_option("--latency-jitter-seed", args->replay.latency_jitter_seed,
+                  "replay: seed of the latency jitter")
+      ->capture_default_str();
+  cmd->add_option("--motion-model", p.motion_model, "kalman or constant_velocity_fit")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, gps::MotionModel>{
+              {"kalman", gps::MotionModel::kKalman},
+              {"constant_velocity_fit", gps::MotionModel::kConstantVelocityFit}},
+          CLI::ignore_case));
   cmd->add_option("--cross-track", p.cross_track_tolerance_m, "cross-track tolerance, metres")
       ->capture_default_str()
       ->check(finiteRange(0.01, 100.0));

@@ -26,9 +26,13 @@ struct TriggerEvent {
   UtcTime time{};                // GPS time at which the trigger fires
   UtcTime planned_time{};        // the predicted crossing (equals `time` unless late)
   TriggerStatus status = TriggerStatus::kOnTime;
-  double speed_mps = 0;       // estimated ground speed when planned
-  double course_deg = 0;      // estimated course over ground when planned
-  double cross_track_m = 0;   // signed lateral offset of the location (+ = right of travel)
+  double speed_mps = 0;      // estimated ground speed when planned
+  double course_deg = 0;     // estimated course over ground when planned
+  double cross_track_m = 0;  // signed lateral offset of the location (+ = right of travel)
+  // The planner's own 1-sigma uncertainty of the crossing it predicted: in time, and as the
+  // along-track distance of the antenna from the location when the trigger fires.
+  double timing_sigma_s = 0;
+  double along_track_sigma_m = 0;
   UtcTime last_fix_time{};    // the latest fix the plan used (always before `time`)
   std::optional<GpsFix> fix;  // that fix itself: where the tractor was, as the receiver said
   // Host clock when the rig sent the trigger to the cameras (set by the rig; zero for triggers

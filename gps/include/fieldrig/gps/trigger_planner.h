@@ -2,11 +2,16 @@
 // the current GPS time as an argument, so replay and tests drive it directly.
 //
 // Fixes arrive at 10 Hz; at 2 m/s the antenna moves 20 cm between them, so firing on the first
-// fix past a location is 10 cm late on average. Instead the planner fits a constant-velocity
-// track to the recent fixes (least squares, which also averages the 1–2 cm RTK noise), predicts
-// when the antenna crosses each nearby location along the direction of travel, and schedules a
-// trigger for that moment. The live daemon arms a steady_timer for nextTriggerTime(); replay
-// calls collectDue() with the next fix's availability time.
+// fix past a location is 10 cm late on average. Instead the planner tracks the antenna's motion,
+// predicts when it crosses each nearby location along the direction of travel, and schedules a
+// trigger for that moment. The motion model is a Kalman filter on position, velocity and
+// acceleration (per horizontal axis, white-jerk process noise) that takes the receiver's reported
+// speed and course over ground (RMC, Doppler-derived: free of the position noise) as well as its
+// positions: a tractor's speed breathes by ±10–15 % over tens of seconds, which a constant-velocity
+// fit over the last second follows only with a lag of centimetres. The older constant-velocity
+// least-squares fit stays selectable (MotionModel::kConstantVelocityFit) for comparison. The live
+// daemon arms a steady_timer for nextTriggerTime(); replay calls collectDue() with the next fix's
+// availability time.
 //
 // Time: all times are receiver UTC ("GPS time"). A fix is usable only once it has been received:
 // its time plus the receiver-and-serial latency. addFix() is therefore given `now`, the GPS time
@@ -29,6 +34,12 @@
 
 namespace fieldrig::gps {
 
+enum class MotionModel {
+  kKalman,               // position, velocity, acceleration; uses reported speed and course
+  kConstantVelocityFit,  // least-squares straight line through the fixes of fit_window_s
+};
+std::string_view toString(MotionModel model);  // "kalman", "constant_velocity_fit"
+
 struct TriggerOptions {
   double cross_track_tolerance_m = 0.5;  // |lateral offset| allowed; rows are ≥ 0.76 m apart
   double heading_tolerance_deg = 60;     // course must be within ± this of a location's heading
@@ -42,6 +53,13 @@ struct TriggerOptions {
   double fit_residual_limit_m =
       0.05;                     // RMS residual above which the fit window is shortened (turns)
   double trigger_lead_s = 0.0;  // fire this much before the crossing (camera exposure delay)
+  MotionModel motion_model = MotionModel::kKalman;
+  // Kalman filter: how fast the acceleration may change (white-jerk spectral density, m²/s⁵;
+  // larger follows speed changes sooner and averages less noise), and the measurement noise of a
+  // fix's position (per axis) and of its velocity from speed and course (per axis).
+  double kalman_jerk_density = 0.5;
+  double kalman_position_sd_m = 0.015;
+  double kalman_velocity_sd_mps = 0.05;
 };
 
 // The planner's options and the receiver-to-host latency: what replay (in GPS time) and the live
@@ -51,6 +69,11 @@ struct TriggerChainOptions {
   // Receiver and serial latency: from the fix's time to its last byte reaching the host. RTK
   // receivers output 20-50 ms after the epoch, and two sentences take ~10 ms at 115200 baud.
   double latency_s = 0.05;
+  // Replay only (the live chain sees the real arrivals): each fix becomes usable at its time +
+  // latency_s + a uniform draw in ±latency_jitter_s (at most latency_s), seeded: the receiver's
+  // computation and serial queueing vary the latency from fix to fix.
+  double latency_jitter_s = 0;
+  std::uint32_t latency_jitter_seed = 1;
 };
 
 enum class AlarmKind {
@@ -78,6 +101,11 @@ struct TriggerStats {
   std::uint64_t stale_plans_dropped = 0;
   std::uint64_t missed = 0;
   std::uint64_t too_fast = 0;
+  std::uint64_t filter_resets = 0;  // a fix far outside the filter's prediction (a turn, a jump)
+  // The planner's own 1-sigma estimate for the latest trigger: of the crossing time, and of the
+  // antenna's along-track position at the moment of firing (0 before the first trigger).
+  double last_timing_sigma_s = 0;
+  double last_along_track_sigma_m = 0;
 };
 
 class TriggerPlanner {
