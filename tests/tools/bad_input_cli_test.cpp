@@ -23,8 +23,9 @@ constexpr int kBadInput = 2;
 
 // A case: the command line, with placeholders for the files the suite prepares — {map} and
 // {nmea} (a simulated drive), {session} (one synthetic plot with its calibration), {cloud} (a
-// synthetic plot cloud), {dir} (a folder), {out} (a path nothing is at yet) and {config} (a file
-// holding `config`) — the exit code and what stderr must contain.
+// synthetic plot cloud), {dir} (a folder), {out} (a path nothing is at yet), {config} and {ply}
+// (files holding `config`) and {calib} (a folder whose rig.yml holds `config`) — the exit code and
+// what stderr must contain.
 struct BadInputCase {
   std::string name;
   std::vector<std::string> args;
@@ -211,6 +212,42 @@ std::vector<BadInputCase> pathCases() {
   };
 }
 
+// Damaged files, written from the case's text: {ply} a cloud, {calib} a calibration folder
+// whose rig.yml it is.
+std::vector<BadInputCase> damagedFileCases() {
+  const std::string rig_head = "%YAML:1.0\nheads: [ bottom ]\n";
+  return {
+      // PCL's reader read a word as NaN and the traits went on with exit 0.
+      {"TraitsPlyWithAWord",
+       {"traits", "--cloud", "{ply}"},
+       "cloud.ply:9: 'x1' is not a number",
+       "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+       "property float z\nend_header\n1 2 3\n4 x1 6\n"},
+      // PCL's reader failed an assert() (exit 134) on a colour out of order.
+      {"TraitsPlyBlueBeforeRed",
+       {"traits", "--cloud", "{ply}"},
+       "cloud.ply:",
+       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+       "property float z\nproperty uchar blue\nend_header\n1 2\n"},
+      // OpenCV allocated the declared 2^31 x 2^31 matrix before reading it.
+      {"ProcessRigHugeMatrix",
+       {"process", "{session}", "--calib", "{calib}", "--out", "{out}"},
+       "field 'bottom_to_bottom'",
+       rig_head + "bottom_to_bottom: !!opencv-matrix\n  rows: 2147483647\n"
+                  "  cols: 2147483647\n  dt: d\n  data: [ 1 ]\n"},
+      // A head name became a folder path outside the calibration folder.
+      {"ProcessRigHeadNameIsAPath",
+       {"process", "{session}", "--calib", "{calib}", "--out", "{out}"},
+       "'../../x' is not a head name",
+       "%YAML:1.0\nheads: [ \"../../x\" ]\n"},
+      // OpenCV's parser threw std::length_error through the loader (exit 134).
+      {"ProcessRigKeyWithoutName",
+       {"process", "{session}", "--calib", "{calib}", "--out", "{out}"},
+       "rig.yml: not a readable OpenCV YAML/XML file",
+       "%YAML:1.0\n:1.0\n"},
+  };
+}
+
 // The files a case names, made by the binary itself when a case first needs them: CTest runs
 // each case in a process of its own, so nothing is made that the case does not use.
 class BadInputCli : public ::testing::TestWithParam<BadInputCase> {
@@ -260,6 +297,8 @@ class BadInputCli : public ::testing::TestWithParam<BadInputCase> {
         {"{dir}", (dir() / "a_folder").string()},
         {"{out}", (case_dir / "out").string()},
         {"{config}", (case_dir / "options.yaml").string()},
+        {"{ply}", (case_dir / "cloud.ply").string()},
+        {"{calib}", (case_dir / "calib").string()},
     };
     for (const auto& [token, value] : placeholders) {
       for (std::size_t at = text.find(token); at != std::string::npos;
@@ -283,8 +322,12 @@ TEST_P(BadInputCli, ExitsWithBadInputNamingTheCulprit) {
     if (HasFatalFailure())
       return;
   }
-  if (!c.config.empty())
+  if (!c.config.empty()) {
     std::ofstream(case_dir / "options.yaml") << c.config;
+    std::ofstream(case_dir / "cloud.ply", std::ios::binary) << c.config;
+    fs::create_directories(case_dir / "calib");
+    std::ofstream(case_dir / "calib" / "rig.yml", std::ios::binary) << c.config;
+  }
   std::vector<std::string> args = {"60", kFieldrigBinary};
   for (const std::string& arg : c.args)
     args.push_back(substitute(arg, case_dir));
@@ -305,6 +348,8 @@ INSTANTIATE_TEST_SUITE_P(Numbers, BadInputCli, ::testing::ValuesIn(numberCases()
 INSTANTIATE_TEST_SUITE_P(TraitsOptions, BadInputCli, ::testing::ValuesIn(traitsOptionCases()),
                          caseName);
 INSTANTIATE_TEST_SUITE_P(Paths, BadInputCli, ::testing::ValuesIn(pathCases()), caseName);
+INSTANTIATE_TEST_SUITE_P(DamagedFiles, BadInputCli, ::testing::ValuesIn(damagedFileCases()),
+                         caseName);
 
 // A 400 MB frame pool under a 600 MB address-space limit, with flags that are all in range: the
 // pool's allocation fails, and the run ends as one line naming the command and the size, exit 2.
