@@ -4,8 +4,8 @@
 // pty); the page watches it. Then the daemon ends and another starts on the same port. Checked on
 // the page: the dots turn from pending to processed (green) as the replay passes them, the
 // location passed in the silence is red (missed), the gps_lost alarm shows within a second of
-// the daemon raising it, with its meaning and what to do, and the lost daemon is shown and its
-// return recovered. Screenshots of three moments go to build/tests/tools/cab_page/.
+// the daemon raising it (in the list, with its meaning and what to do, and in the banner at the
+// top), and the lost daemon is shown and its return recovered. Screenshots of three moments go to build/tests/tools/cab_page/.
 // Skips when Chromium is not installed.
 #include <signal.h>
 
@@ -165,6 +165,14 @@ TEST(CabPageBrowser, ReplayGpsLossMissedPlotAndDaemonRestartAsTheOperatorSeesThe
   EXPECT_NE(lost.at("text").get<std::string>().find("check the receiver and its cable"),
             std::string::npos)
       << lost.dump();
+  // And in the banner at the top, in sight on the smallest screen.
+  ASSERT_TRUE(seen.contains("gps_lost_banner")) << seen.dump();
+  const Json& banner = seen.at("gps_lost_banner");
+  EXPECT_LT(banner.at("seen_at").get<double>() - isoMillis(lost.at("time").get<std::string>()),
+            1000.0)
+      << banner.dump();
+  EXPECT_NE(banner.at("text").get<std::string>().find("check the receiver"), std::string::npos)
+      << banner.dump();
   ASSERT_TRUE(seen.at("alarms").contains("missed")) << seen.dump();
   // The daemon's end shown, its successor's run followed.
   EXPECT_NE(seen.at("lost_note").get<std::string>().find("no contact since"), std::string::npos)

@@ -27,7 +27,9 @@ function look() {
            row: document.getElementById("row-name").textContent,
            tractor: document.getElementById("tractor").getAttribute("visibility"),
            gauge: document.getElementById("gauge").dataset.level,
-           gps_fix: document.getElementById("gps-fix").textContent };
+           gps_fix: document.getElementById("gps-fix").textContent,
+           banner: document.getElementById("alarm-banner").innerText,
+           banner_visible: getComputedStyle(document.getElementById("alarm-banner")).display !== "none" };
 }
 
 (async () => {
@@ -64,14 +66,18 @@ function look() {
         if (!seen.alarms[alarm.kind])
           seen.alarms[alarm.kind] = { seen_at: now, time: alarm.time, text: alarm.text };
       }
+      // The banner at the top: the first time it showed the GPS loss.
+      if (view.banner_visible && view.banner.includes("gps_lost") && !seen.gps_lost_banner) {
+        seen.gps_lost_banner = { seen_at: now, text: view.banner };
+      }
       seen.last_view = view;
       const missed = view.dots.find(([id]) => id === testCase.missed);
       if (moment === 0 && view.dots.some(([, state]) => state !== "pending")) {
-        await page.screenshot({ path: path.join(outDir, "cab_page_1_first_plots.png") });
+        await page.screenshot({ path: path.join(outDir, "cab_page_1_first_plots.png"), fullPage: true });
         seen.screenshots.push("cab_page_1_first_plots.png");
         moment = 1;
       } else if (moment === 1 && seen.alarms.gps_lost && missed && missed[1] === "missed") {
-        await page.screenshot({ path: path.join(outDir, "cab_page_2_gps_lost_missed.png") });
+        await page.screenshot({ path: path.join(outDir, "cab_page_2_gps_lost_missed.png"), fullPage: true });
         seen.screenshots.push("cab_page_2_gps_lost_missed.png");
         seen.first_run_view = view;
         moment = 2;
@@ -84,7 +90,7 @@ function look() {
         // The second daemon's run: its own first plots on the page.
         seen.regained_seen_at = now;
         seen.regained_note = view.note;
-        await page.screenshot({ path: path.join(outDir, "cab_page_3_reconnected.png") });
+        await page.screenshot({ path: path.join(outDir, "cab_page_3_reconnected.png"), fullPage: true });
         seen.screenshots.push("cab_page_3_reconnected.png");
         moment = 4;
       }
