@@ -21,6 +21,7 @@
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <thread>
 
@@ -38,6 +39,7 @@
 #include "fieldrig/pipeline/plot_processor.h"
 #include "fieldrig/sim/nmea_player.h"
 #include "fieldrig/sim/sim_camera.h"
+#include "fieldrig/stereo/preprocess.h"
 #include "service_notifier.h"
 
 namespace fieldrig::daemon {
@@ -52,6 +54,7 @@ constexpr double kGpsLostAfterS = 1.0;  // ten missed 10 Hz epochs
 constexpr std::size_t kAlarmsKept = 100;
 constexpr double kSpeedWarnRatio = 0.8;  // amber at 80 % of what the cameras can keep up with
 constexpr auto kFinishTimeout = std::chrono::seconds{10};
+constexpr int kThumbnailWidth = 240;  // pixels: six fit a phone's width in two rows
 
 // A location's state on the page, one character each in the status's locations.states.
 constexpr char kPending = '.', kTriggered = 't', kRecorded = 'r', kProcessed = 'p', kMissed = 'm',
@@ -263,6 +266,7 @@ class Daemon {
     if (config_.status.enabled) {
       StatusServerOptions status_options;
       status_options.map_json = map_json_;
+      status_options.more_routes = [this](const std::string& path) { return thumbnail(path); };
       status_options.clock_fields = {"/time", "/uptime_s", "/gps/fix_age_s",
                                      "/disk", "/memory",   "/processing/last_latency_ms"};
       auto server = StatusServer::start(
@@ -541,6 +545,7 @@ class Daemon {
     const auto heads =
         headFramesFromFrameSet(set, acquisition_->cameraNames(), processor_->rig(), problems);
     const pipeline::PlotResult result = processor_->process(heads, std::move(problems));
+    keepThumbnails(heads, set.trigger_id);
     const core::TriggerEvent& event = set.trigger;
     PlotIdentity identity;
     identity.trigger_id = set.trigger_id;
@@ -591,6 +596,43 @@ class Daemon {
                            {"message", message}});
     if (alarms_.size() > kAlarmsKept)
       alarms_.pop_front();
+  }
+
+  // The set's images, kThumbnailWidth pixels wide, as JPEG for the page (head by head, left then
+  // right): a few milliseconds beside the plot's stereo. An image that cannot be made stays
+  // empty (the page shows its place blank).
+  void keepThumbnails(const std::vector<cloud::HeadFrames>& heads, std::uint64_t trigger_id) {
+    std::vector<std::string> thumbnails;
+    for (const cloud::HeadFrames& head : heads) {
+      for (const cv::Mat* image : {&head.left, &head.right}) {
+        std::string jpeg;
+        if (!image->empty()) {
+          auto small = stereo::debayerAndScale(*image, head.pixel_format,
+                                               kThumbnailWidth / static_cast<double>(image->cols));
+          std::vector<std::uint8_t> bytes;
+          if (small && cv::imencode(".jpg", *small, bytes, {cv::IMWRITE_JPEG_QUALITY, 80}))
+            jpeg.assign(bytes.begin(), bytes.end());
+        }
+        thumbnails.push_back(std::move(jpeg));
+      }
+    }
+    std::lock_guard lock(thumbnails_mutex_);
+    thumbnails_ = std::move(thumbnails);
+    thumbnails_set_ = trigger_id;
+  }
+
+  // /thumbnail/N.jpg: the last processed set's Nth image (see keepThumbnails).
+  std::optional<HttpReply> thumbnail(const std::string& path) const {
+    static const std::string prefix = "/thumbnail/";
+    if (path.rfind(prefix, 0) != 0 || path.size() != prefix.size() + 5 ||
+        path.compare(prefix.size() + 1, 4, ".jpg") != 0 || path[prefix.size()] < '0' ||
+        path[prefix.size()] > '9')
+      return std::nullopt;
+    const auto index = static_cast<std::size_t>(path[prefix.size()] - '0');
+    std::lock_guard lock(thumbnails_mutex_);
+    if (index >= thumbnails_.size() || thumbnails_[index].empty())
+      return HttpReply{boost::beast::http::status::not_found, "text/plain", "no such image\n", {}};
+    return HttpReply{boost::beast::http::status::ok, "image/jpeg", thumbnails_[index], {}};
   }
 
   // The state of a location of the map, or nullptr (a manual trigger, an unknown id). Under
@@ -708,6 +750,10 @@ class Daemon {
                    {"frames_dropped", stats.rig.frames_dropped},
                    {"frames_corrupt", stats.rig.frames_corrupt},
                    {"recording_stopped", stats.recording_stopped}};
+    {
+      std::lock_guard thumbnails_lock(thumbnails_mutex_);
+      out["thumbnails"] = {{"set", thumbnails_set_}, {"count", thumbnails_.size()}};
+    }
     out["processing"] = {{"enabled", processor_.has_value()},
                          {"last_latency_ms", last_latency_ms_},
                          {"max_latency_ms", max_latency_ms_},
@@ -825,6 +871,10 @@ class Daemon {
   std::vector<double> latencies_ms_;  // trigger sent → plot written, per processed set
   Json last_plot_ = nullptr;
   std::deque<Json> alarms_;
+  // The last processed set's images for the page: written by processing, read by the status.
+  mutable std::mutex thumbnails_mutex_;
+  std::vector<std::string> thumbnails_;
+  std::uint64_t thumbnails_set_ = 0;
   std::uint64_t alarms_total_ = 0;
 };
 

@@ -35,6 +35,7 @@ struct Routes {
   std::string map_json;
   std::string guide_json;
   std::shared_ptr<EventFeed> feed;
+  std::function<std::optional<HttpReply>(const std::string& path)> more_routes;
 };
 
 HttpReply answer(const Routes& routes, const HttpRequest& request) {
@@ -58,6 +59,8 @@ HttpReply answer(const Routes& routes, const HttpRequest& request) {
     reply.events = routes.feed;
   } else if (path == "/healthz") {
     reply = {http::status::ok, "text/plain", "ok\n", {}};
+  } else if (auto more = routes.more_routes ? routes.more_routes(path) : std::nullopt) {
+    reply = std::move(*more);
   } else {
     reply = {http::status::not_found,
              "text/plain",
@@ -162,6 +165,7 @@ core::Result<std::unique_ptr<StatusServer>> StatusServer::start(const std::strin
   routes->map_json = options.map_json + "\n";
   routes->guide_json = alarmGuideJson().dump() + "\n";
   routes->feed = std::make_shared<EventFeed>();
+  routes->more_routes = options.more_routes;
   impl->thread = std::thread([server = impl->server.get(), routes] {
     server->run([&routes](const HttpRequest& request) { return answer(*routes, request); });
   });

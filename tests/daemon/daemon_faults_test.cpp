@@ -271,6 +271,17 @@ TEST_F(DaemonFaults, StatusIsServedAsJsonWhileItRuns) {
   }
   EXPECT_EQ(map.at("locations").at(0).at(2), 0.0);  // the first location is the origin
   EXPECT_NE(testing_support::httpGet(port, "/").find("<title>fieldrig"), std::string::npos);
+  // The last processed set's six images as JPEG; nothing beyond them.
+  EXPECT_EQ(status.at("thumbnails").at("count"), 6) << status.dump();
+  for (int i = 0; i < 6; ++i) {
+    const std::string jpeg =
+        testing_support::httpGet(port, "/thumbnail/" + std::to_string(i) + ".jpg");
+    ASSERT_GT(jpeg.size(), 100U) << i;
+    EXPECT_EQ(jpeg.substr(0, 3), "\xFF\xD8\xFF") << i;
+  }
+  EXPECT_EQ(testing_support::httpGet(port, "/thumbnail/6.jpg"), "no such image\n");
+  EXPECT_EQ(testing_support::httpGet(port, "/thumbnail/../../etc/passwd").find("root"),
+            std::string::npos);
   EXPECT_EQ(testing_support::httpGet(port, "/healthz"), "ok\n");
   ASSERT_EQ(daemon.waitExit(120s), 0) << daemon.err();
 }

@@ -5,8 +5,8 @@
 // the page: the dots turn from pending to processed (green) as the replay passes them, the
 // location passed in the silence is red (missed), the gps_lost alarm shows within a second of
 // the daemon raising it (in the list, with its meaning and what to do, and in the banner at the
-// top), and the lost daemon is shown and its return recovered. Screenshots of three moments go to build/tests/tools/cab_page/.
-// Skips when Chromium is not installed.
+// top), and the lost daemon is shown and its return recovered. Screenshots of three moments go to
+// build/tests/tools/cab_page/. Skips when Chromium is not installed.
 #include <signal.h>
 
 #include <gtest/gtest.h>
@@ -149,6 +149,11 @@ TEST(CabPageBrowser, ReplayGpsLossMissedPlotAndDaemonRestartAsTheOperatorSeesThe
       processed = processed || (step.at(0) == "processed" && step.at(1) == green);
     EXPECT_TRUE(processed) << steps.dump();
   }
+  // The last plot's six images (three heads, left and right), 240 pixels wide, shown.
+  const Json thumbnails = seen.at("first_run_view").at("thumbnails");
+  ASSERT_EQ(thumbnails.size(), 6U) << seen.at("first_run_view").dump();
+  for (const Json& width : thumbnails)
+    EXPECT_EQ(width, 240) << thumbnails.dump();
   // The plot passed in the silence: red, missed, in the first run.
   EXPECT_EQ(first_plots.count("R01P03"), 0U);
   bool missed_red = false;

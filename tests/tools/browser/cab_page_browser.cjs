@@ -28,6 +28,8 @@ function look() {
            tractor: document.getElementById("tractor").getAttribute("visibility"),
            gauge: document.getElementById("gauge").dataset.level,
            gps_fix: document.getElementById("gps-fix").textContent,
+           thumbnails: [...document.querySelectorAll("#thumbnails img")].map(
+             (image) => image.complete ? image.naturalWidth : -1),
            banner: document.getElementById("alarm-banner").innerText,
            banner_visible: getComputedStyle(document.getElementById("alarm-banner")).display !== "none" };
 }

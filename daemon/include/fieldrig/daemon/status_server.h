@@ -6,6 +6,7 @@
 //   GET /status    the JSON snapshot the daemon provides
 //   GET /map       the map's static part (locations, rows, local frame), given at start
 //   GET /guide     the alarms' meanings and what to do (alarmGuide())
+//   and what StatusServerOptions::more_routes answers (fieldrigd: /thumbnail/N.jpg)
 //   GET /healthz   "ok"
 // Read-only: nothing a request carries can change the run or reach a file. It runs on its own
 // threads (one serving, one taking snapshots while a page listens), so a slow or hostile client
@@ -17,11 +18,13 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "fieldrig/core/result.h"
+#include "fieldrig/daemon/http_server.h"
 
 namespace fieldrig::daemon {
 
@@ -44,6 +47,9 @@ struct StatusServerOptions {
   std::vector<std::string> clock_fields;
   std::chrono::milliseconds event_period{100};
   std::chrono::milliseconds refresh_period{1000};
+  // More read-only GET routes (the last plot's thumbnails): a reply for the path, or nullopt
+  // when it is not theirs. Called on the serving thread.
+  std::function<std::optional<HttpReply>(const std::string& path)> more_routes;
 };
 
 class StatusServer {
