@@ -15,6 +15,9 @@ namespace http = boost::beast::http;
 using Json = nlohmann::ordered_json;
 using Clock = std::chrono::steady_clock;
 
+// How long a stopping server gives its open pages to take the last state.
+constexpr std::chrono::milliseconds kLastEventGrace{300};
+
 // One request per connection, small and quick: a request larger than 8 KiB or slower than 5 s
 // is dropped. An event stream stays open; a client that does not take an event within 5 s is
 // dropped (its page reconnects).
@@ -105,6 +108,8 @@ Json alarmGuideJson() {
 
 struct StatusServer::Impl {
   std::unique_ptr<HttpServer> server;
+  Snapshot snapshot;
+  std::shared_ptr<EventFeed> feed;
   std::thread thread;
   // The publisher: takes a snapshot every event_period while a page listens.
   std::thread publisher;
@@ -113,16 +118,15 @@ struct StatusServer::Impl {
   bool stopping = false;  // guarded by mutex
   std::atomic<std::uint64_t> published{0};
 
-  void publish(const Snapshot& snapshot, const StatusServerOptions& options, EventFeed& feed);
+  void publish(const StatusServerOptions& options);
 };
 
-void StatusServer::Impl::publish(const Snapshot& snapshot, const StatusServerOptions& options,
-                                 EventFeed& feed) {
+void StatusServer::Impl::publish(const StatusServerOptions& options) {
   std::string last_without_clocks;
   Clock::time_point last_sent{};
   std::unique_lock lock(mutex);
   while (!wake.wait_for(lock, options.event_period, [this] { return stopping; })) {
-    if (feed.subscribers() == 0) {
+    if (feed->subscribers() == 0) {
       last_without_clocks.clear();  // a new page gets the state at once
       continue;
     }
@@ -138,7 +142,7 @@ void StatusServer::Impl::publish(const Snapshot& snapshot, const StatusServerOpt
     std::string compared = without_clocks.dump();
     const Clock::time_point now = Clock::now();
     if (compared != last_without_clocks || now - last_sent >= options.refresh_period) {
-      feed.publish("event: status\ndata: " + state.dump() + "\n\n");
+      feed->publish("event: status\ndata: " + state.dump() + "\n\n");
       published.fetch_add(1, std::memory_order_relaxed);
       last_without_clocks = std::move(compared);
       last_sent = now;
@@ -166,12 +170,13 @@ core::Result<std::unique_ptr<StatusServer>> StatusServer::start(const std::strin
   routes->guide_json = alarmGuideJson().dump() + "\n";
   routes->feed = std::make_shared<EventFeed>();
   routes->more_routes = options.more_routes;
+  impl->snapshot = routes->snapshot;
+  impl->feed = routes->feed;
   impl->thread = std::thread([server = impl->server.get(), routes] {
     server->run([&routes](const HttpRequest& request) { return answer(*routes, request); });
   });
-  impl->publisher = std::thread([impl = impl.get(), routes, options = std::move(options)] {
-    impl->publish(routes->snapshot, options, *routes->feed);
-  });
+  impl->publisher =
+      std::thread([impl = impl.get(), options = std::move(options)] { impl->publish(options); });
   return std::unique_ptr<StatusServer>(new StatusServer(std::move(impl)));
 }
 
@@ -185,6 +190,12 @@ StatusServer::~StatusServer() {
   impl_->wake.notify_all();
   if (impl_->publisher.joinable())
     impl_->publisher.join();
+  // The run's last state reaches the open pages before the port closes (the last plot's
+  // colour, which may have come less than an event period before the end).
+  if (impl_->feed->subscribers() > 0) {
+    impl_->feed->publish("event: status\ndata: " + impl_->snapshot().dump() + "\n\n");
+    std::this_thread::sleep_for(kLastEventGrace);
+  }
   impl_->server->stop();
   if (impl_->thread.joinable())
     impl_->thread.join();
