@@ -116,9 +116,9 @@ TEST(CabPageBrowser, ReplayGpsLossMissedPlotAndDaemonRestartAsTheOperatorSeesThe
   const std::set<std::string> first_plots = plotsOf(testing_support::splitLines(first_out));
   const std::string first_log = first->err();
   first.reset();
-  // Long enough for the page to notice (it retries every second), then a new daemon on the
-  // same port, as after a restart by systemd.
-  std::this_thread::sleep_for(3s);
+  // Once the page shows the daemon gone, a new daemon on the same port, as after a restart by
+  // systemd.
+  ASSERT_TRUE(watcher.waitForStdoutLines(1, 120s)) << watcher.err();
   const fs::path second_config =
       testing_support::writeReplayConfig(dir.path(), "second", field, "", "", {});
   {
@@ -133,7 +133,9 @@ TEST(CabPageBrowser, ReplayGpsLossMissedPlotAndDaemonRestartAsTheOperatorSeesThe
   second.signal(SIGTERM);
   EXPECT_EQ(second.waitExit(60s), 0) << second.err();
   ASSERT_EQ(watched, 0) << watcher.err() << watcher.out();
-  const Json seen = Json::parse(watcher.out());
+  const std::vector<std::string> watched_lines = watcher.outLines();
+  ASSERT_EQ(watched_lines.size(), 2U) << watcher.out();
+  const Json seen = Json::parse(watched_lines.back());
 
   // Every location the first run triggered was seen pending, then green once processed (blue,
   // recorded, when live processing fell behind on a slow machine and skipped it: the summary

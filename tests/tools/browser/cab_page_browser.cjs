@@ -5,7 +5,8 @@
 // when each changed (wall-clock ms; the dots in the first run only). Screenshots at three moments into OUT_DIR.
 //   node cab_page_browser.cjs URL OUT_DIR CASE_JSON
 // CASE_JSON: {"locations": 12, "missed": "R01P03", "timeout_s": 240}.
-// Prints one JSON line with what it saw; exits non-zero when a moment never came.
+// Prints a JSON line when it saw the daemon go, and at the end one with all it saw; exits
+// non-zero when a moment never came.
 "use strict";
 const path = require("node:path");
 const { chromium } = require("playwright-core");
@@ -87,6 +88,7 @@ function look() {
       } else if (moment === 2 && view.connection === "lost") {
         seen.lost_seen_at = now;
         seen.lost_note = view.note;
+        console.log(JSON.stringify({ lost_seen_at: now }));  // the test starts the next daemon
         moment = 3;
       } else if (moment === 3 && view.connection === "connected" &&
                  view.dots.some(([, state]) => state !== "pending")) {
