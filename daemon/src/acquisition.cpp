@@ -219,6 +219,8 @@ void Acquisition::recordLoop() {
       spdlog::error("acquisition: recording stopped: {}", outcome.message);
       continue;
     }
+    if (options_.on_recorded)
+      options_.on_recorded(record.location_id.value_or(std::string()), record.complete);
     recorded_.fetch_add(1, std::memory_order_relaxed);
     bytes_.store(writer_.bytesWritten(), std::memory_order_relaxed);
     progress_.ring();

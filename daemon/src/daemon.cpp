@@ -21,6 +21,7 @@
 #include <map>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <thread>
 
@@ -38,6 +39,7 @@
 #include "fieldrig/pipeline/plot_processor.h"
 #include "fieldrig/sim/nmea_player.h"
 #include "fieldrig/sim/sim_camera.h"
+#include "fieldrig/stereo/preprocess.h"
 #include "service_notifier.h"
 
 namespace fieldrig::daemon {
@@ -52,6 +54,11 @@ constexpr double kGpsLostAfterS = 1.0;  // ten missed 10 Hz epochs
 constexpr std::size_t kAlarmsKept = 100;
 constexpr double kSpeedWarnRatio = 0.8;  // amber at 80 % of what the cameras can keep up with
 constexpr auto kFinishTimeout = std::chrono::seconds{10};
+constexpr int kThumbnailWidth = 240;  // pixels: six fit a phone's width in two rows
+
+// A location's state on the page, one character each in the status's locations.states.
+constexpr char kPending = '.', kTriggered = 't', kRecorded = 'r', kProcessed = 'p', kMissed = 'm',
+               kIncomplete = 'i';
 
 struct RowCounts {
   std::uint64_t locations = 0, fired = 0, late = 0, missed = 0;
@@ -144,6 +151,8 @@ class Daemon {
       return kExitBadInput;
     }
     map_ = std::move(*map);
+    frame_.emplace(map_.locations().front().latitude_deg, map_.locations().front().longitude_deg);
+    location_states_.assign(map_.size(), kPending);
     const auto& columns = map_.metadataColumns();
     const auto row_column = std::find(columns.begin(), columns.end(), "row");
     for (const auto& location : map_.locations()) {
@@ -156,6 +165,7 @@ class Daemon {
       location_rows_[location.id] = row;
       ++rows_[row].locations;
     }
+    map_json_ = mapJson();
     max_speed_mps_ = maxSpeedFor(map_, config_.gps.triggers.planner.min_trigger_interval_s);
 
     if (options_.mode == Mode::kReplay && config_.replay.nmea.empty()) {
@@ -213,6 +223,15 @@ class Daemon {
     acquisition.session_dir = config_.recording.dir;
     acquisition.writer = config_.recording.writer;
     acquisition.processing_queue_sets = std::max<std::size_t>(1, config_.pipeline.queue_sets);
+    acquisition.on_recorded = [this](const std::string& location_id, bool complete) {
+      std::lock_guard lock(health_mutex_);
+      if (char* state = locationState(location_id)) {
+        if (!complete)
+          *state = kIncomplete;
+        else if (*state == kTriggered)
+          *state = kRecorded;
+      }
+    };
     acquisition.session.configuration = {
         {"recorded_by", "fieldrigd"},
         {"mode", options_.mode == Mode::kRun ? "run" : "replay"},
@@ -245,8 +264,14 @@ class Daemon {
     }
     // The status port is taken before the session is opened: a port in use leaves nothing written.
     if (config_.status.enabled) {
-      auto server = StatusServer::start(config_.status.address, config_.status.port,
-                                        [this] { return snapshot(); });
+      StatusServerOptions status_options;
+      status_options.map_json = map_json_;
+      status_options.more_routes = [this](const std::string& path) { return thumbnail(path); };
+      status_options.clock_fields = {"/time", "/uptime_s", "/gps/fix_age_s",
+                                     "/disk", "/memory",   "/processing/last_latency_ms"};
+      auto server = StatusServer::start(
+          config_.status.address, config_.status.port, [this] { return snapshot(); },
+          std::move(status_options));
       if (!server) {
         spdlog::error("{}", server.error().message);
         return kExitBadInput;
@@ -303,6 +328,10 @@ class Daemon {
     if (!accepted)
       ++refused_;
     last_trigger_ = event;
+    if (char* state = locationState(event.location_id)) {
+      *state = kTriggered;
+      current_row_ = rowOf(event.location_id);
+    }
   }
 
   void onPlannerAlarm(const gps::PlannerAlarm& planner_alarm) {
@@ -313,6 +342,10 @@ class Daemon {
         ++missed_;
         ++rows_[rowOf(planner_alarm.location_id)].missed;
         missed_locations_.push_back(planner_alarm.location_id);
+        if (char* state = locationState(planner_alarm.location_id)) {
+          *state = kMissed;
+          current_row_ = rowOf(planner_alarm.location_id);
+        }
       } else {
         ++too_fast_;
       }
@@ -512,6 +545,7 @@ class Daemon {
     const auto heads =
         headFramesFromFrameSet(set, acquisition_->cameraNames(), processor_->rig(), problems);
     const pipeline::PlotResult result = processor_->process(heads, std::move(problems));
+    keepThumbnails(heads, set.trigger_id);
     const core::TriggerEvent& event = set.trigger;
     PlotIdentity identity;
     identity.trigger_id = set.trigger_id;
@@ -533,6 +567,10 @@ class Daemon {
                                         std::chrono::system_clock::now() - event.sent_time)
                                         .count();
     std::lock_guard lock(health_mutex_);
+    if (char* state = locationState(event.location_id)) {
+      if (*state == kTriggered || *state == kRecorded)
+        *state = result.partial ? kIncomplete : kProcessed;
+    }
     latencies_ms_.push_back(latency_ms);
     last_latency_ms_ = latency_ms;
     max_latency_ms_ = std::max(max_latency_ms_, latency_ms);
@@ -558,6 +596,78 @@ class Daemon {
                            {"message", message}});
     if (alarms_.size() > kAlarmsKept)
       alarms_.pop_front();
+  }
+
+  // The set's images, kThumbnailWidth pixels wide, as JPEG for the page (head by head, left then
+  // right): a few milliseconds beside the plot's stereo. An image that cannot be made stays
+  // empty (the page shows its place blank).
+  void keepThumbnails(const std::vector<cloud::HeadFrames>& heads, std::uint64_t trigger_id) {
+    std::vector<std::string> thumbnails;
+    for (const cloud::HeadFrames& head : heads) {
+      for (const cv::Mat* image : {&head.left, &head.right}) {
+        std::string jpeg;
+        if (!image->empty()) {
+          auto small = stereo::debayerAndScale(*image, head.pixel_format,
+                                               kThumbnailWidth / static_cast<double>(image->cols));
+          std::vector<std::uint8_t> bytes;
+          if (small && cv::imencode(".jpg", *small, bytes, {cv::IMWRITE_JPEG_QUALITY, 80}))
+            jpeg.assign(bytes.begin(), bytes.end());
+        }
+        thumbnails.push_back(std::move(jpeg));
+      }
+    }
+    std::lock_guard lock(thumbnails_mutex_);
+    thumbnails_ = std::move(thumbnails);
+    thumbnails_set_ = trigger_id;
+  }
+
+  // /thumbnail/N.jpg: the last processed set's Nth image (see keepThumbnails).
+  std::optional<HttpReply> thumbnail(const std::string& path) const {
+    static const std::string prefix = "/thumbnail/";
+    if (path.rfind(prefix, 0) != 0 || path.size() != prefix.size() + 5 ||
+        path.compare(prefix.size() + 1, 4, ".jpg") != 0 || path[prefix.size()] < '0' ||
+        path[prefix.size()] > '9')
+      return std::nullopt;
+    const auto index = static_cast<std::size_t>(path[prefix.size()] - '0');
+    std::lock_guard lock(thumbnails_mutex_);
+    if (index >= thumbnails_.size() || thumbnails_[index].empty())
+      return HttpReply{boost::beast::http::status::not_found, "text/plain", "no such image\n", {}};
+    return HttpReply{boost::beast::http::status::ok, "image/jpeg", thumbnails_[index], {}};
+  }
+
+  // The state of a location of the map, or nullptr (a manual trigger, an unknown id). Under
+  // health_mutex_.
+  char* locationState(const std::string& location_id) {
+    const gps::ImagingLocation* location = location_id.empty() ? nullptr : map_.find(location_id);
+    if (location == nullptr)
+      return nullptr;
+    return &location_states_[static_cast<std::size_t>(location - map_.locations().data())];
+  }
+
+  // The map's static part for the page (/map): each location's id, row and place in metres
+  // east and north of the map's first location, in the map's order (that of
+  // locations.states in the status).
+  std::string mapJson() const {
+    Json locations = Json::array();
+    for (const auto& location : map_.locations()) {
+      const gps::EnuPoint p = frame_->toLocal(location.latitude_deg, location.longitude_deg);
+      locations.push_back({location.id, location_rows_.at(location.id),
+                           std::round(p.east_m * 100) / 100, std::round(p.north_m * 100) / 100});
+    }
+    return Json{{"map", config_.map.string()},
+                {"origin",
+                 {{"lat", map_.locations().front().latitude_deg},
+                  {"lon", map_.locations().front().longitude_deg}}},
+                {"fields", {"id", "row", "east_m", "north_m"}},
+                {"locations", locations},
+                {"states",
+                 {{std::string(1, kPending), "pending"},
+                  {std::string(1, kTriggered), "triggered"},
+                  {std::string(1, kRecorded), "recorded"},
+                  {std::string(1, kProcessed), "processed"},
+                  {std::string(1, kMissed), "missed"},
+                  {std::string(1, kIncomplete), "incomplete"}}}}
+        .dump();
   }
 
   std::string rowOf(const std::string& location_id) const {
@@ -595,6 +705,9 @@ class Daemon {
       gps_status["lon"] = last_fix_->longitude_deg;
       gps_status["course_deg"] =
           last_fix_->course_deg ? Json(*last_fix_->course_deg) : Json(nullptr);
+      const gps::EnuPoint p = frame_->toLocal(last_fix_->latitude_deg, last_fix_->longitude_deg);
+      gps_status["east_m"] = std::round(p.east_m * 100) / 100;
+      gps_status["north_m"] = std::round(p.north_m * 100) / 100;
     }
     out["gps"] = gps_status;
     const double speed = last_fix_ && last_fix_->speed_mps ? *last_fix_->speed_mps : 0.0;
@@ -624,6 +737,8 @@ class Daemon {
                                  {"timing_sigma_s", last_trigger_->timing_sigma_s},
                                  {"along_track_sigma_m", last_trigger_->along_track_sigma_m}};
     }
+    // One character per location of the map, in its order (see /map "states"): the page's dots.
+    out["locations"] = {{"states", location_states_}, {"current_row", current_row_}};
     out["queues"] = {{"in_flight", acquisition_->inFlight()},
                      {"to_record", triggered > stats.sets_recorded + stats.sets_lost
                                        ? triggered - stats.sets_recorded - stats.sets_lost
@@ -638,6 +753,10 @@ class Daemon {
                    {"frames_dropped", stats.rig.frames_dropped},
                    {"frames_corrupt", stats.rig.frames_corrupt},
                    {"recording_stopped", stats.recording_stopped}};
+    {
+      std::lock_guard thumbnails_lock(thumbnails_mutex_);
+      out["thumbnails"] = {{"set", thumbnails_set_}, {"count", thumbnails_.size()}};
+    }
     out["processing"] = {{"enabled", processor_.has_value()},
                          {"last_latency_ms", last_latency_ms_},
                          {"max_latency_ms", max_latency_ms_},
@@ -723,6 +842,8 @@ class Daemon {
   const config::Config& config_;
   gps::LocationMap map_;
   std::map<std::string, std::string> location_rows_;
+  std::optional<gps::LocalFrame> frame_;  // metres east and north of the map's first location
+  std::string map_json_;
   double max_speed_mps_ = 0;
   std::optional<pipeline::PlotProcessor> processor_;  // the processing thread's
   std::unique_ptr<ResultsWriter> results_;            // the processing thread's, then finish()'s
@@ -741,6 +862,8 @@ class Daemon {
   std::map<std::string, RowCounts> rows_;
   std::uint64_t triggers_ = 0, late_ = 0, missed_ = 0, too_fast_ = 0, refused_ = 0, fixes_ = 0;
   std::vector<std::string> missed_locations_;
+  std::string location_states_;  // one of kPending… per location of the map, in its order
+  std::string current_row_;      // the row of the latest trigger or missed location
   std::optional<core::GpsFix> last_fix_;
   std::optional<Clock::time_point> last_valid_fix_at_;
   std::optional<core::TriggerEvent> last_trigger_;
@@ -751,6 +874,10 @@ class Daemon {
   std::vector<double> latencies_ms_;  // trigger sent → plot written, per processed set
   Json last_plot_ = nullptr;
   std::deque<Json> alarms_;
+  // The last processed set's images for the page: written by processing, read by the status.
+  mutable std::mutex thumbnails_mutex_;
+  std::vector<std::string> thumbnails_;
+  std::uint64_t thumbnails_set_ = 0;
   std::uint64_t alarms_total_ = 0;
 };
 

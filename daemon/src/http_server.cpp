@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <array>
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -16,6 +17,7 @@
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <utility>
 
 #include "fieldrig/core/exception_message.h"
 
@@ -76,6 +78,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
       : server_(server), stream_(std::move(socket)) {}
 
   ~Connection() {
+    if (feed_ && subscription_ != 0)
+      feed_->unsubscribe(subscription_);
     std::lock_guard lock(server_.mutex);
     if (self_)
       server_.connections.erase(*self_);
@@ -149,6 +153,10 @@ class Connection : public std::enable_shared_from_this<Connection> {
       reply = errorReply(http::status::internal_server_error,
                          "internal error: " + core::currentExceptionMessage());
     }
+    if (reply.events) {
+      stream(std::move(reply));
+      return;
+    }
     answer(std::move(reply), request.version(), server_.options.keep_alive && request.keep_alive());
   }
 
@@ -185,6 +193,77 @@ class Connection : public std::enable_shared_from_this<Connection> {
     stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
   }
 
+  // An event stream: the header by hand (HTTP/1.1 with no length: the body runs until the
+  // connection closes), the reply's body, then the feed's latest message whenever it changes.
+  // The connection counts as waiting from now on, so that at the cap a stream makes room before
+  // a client whose request is under way.
+  void stream(HttpReply reply) {
+    feed_ = std::move(reply.events);
+    std::string head = "HTTP/1.1 200 OK\r\nServer: " + server_.options.name +
+                       "\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n"
+                       "Connection: close\r\n";
+    for (const auto& [name, value] : reply.headers)
+      head += name + ": " + value + "\r\n";
+    pending_ = std::make_shared<const std::string>(head + "\r\n" + reply.body);
+    waiting(true);
+    std::weak_ptr<Connection> weak = weak_from_this();
+    const auto executor = stream_.get_executor();
+    subscription_ = feed_->subscribe([weak, executor] {
+      if (const auto self = weak.lock())
+        asio::post(executor, [self] { self->writeEvents(); });
+    });
+    stream_.expires_never();
+    watchClient();
+    writeEvents();
+  }
+
+  // A read stays pending for the stream's life: it holds the connection while no write does, and
+  // ends the stream when the client closes (or the server closes the socket). What a client
+  // sends on a stream is read and ignored.
+  void watchClient() {
+    stream_.async_read_some(asio::buffer(ignored_),
+                            [self = shared_from_this()](beast::error_code error, std::size_t) {
+                              if (error)
+                                self->endStream();
+                              else
+                                self->watchClient();
+                            });
+  }
+
+  // On the strand: writes what is pending, else the feed's latest message if not yet sent.
+  void writeEvents() {
+    if (writing_ || closed_)
+      return;
+    if (!pending_) {
+      auto [sequence, message] = feed_->latest();
+      if (sequence == sent_sequence_ || !message)
+        return;
+      sent_sequence_ = sequence;
+      pending_ = std::move(message);
+    }
+    writing_ = true;
+    stream_.expires_after(server_.options.write_timeout);
+    asio::async_write(stream_, asio::buffer(*pending_),
+                      [self = shared_from_this()](beast::error_code error, std::size_t) {
+                        self->writing_ = false;
+                        self->pending_.reset();
+                        if (error) {
+                          self->endStream();
+                          return;
+                        }
+                        self->stream_.expires_never();
+                        self->writeEvents();
+                      });
+  }
+
+  void endStream() {
+    closed_ = true;
+    if (feed_ && subscription_ != 0)
+      feed_->unsubscribe(std::exchange(subscription_, 0));
+    beast::error_code ignored;
+    stream_.socket().close(ignored);
+  }
+
   HttpServer::Impl& server_;
   // Its entry in server_.connections, once registered; guarded by server_.mutex.
   std::optional<std::list<ConnectionEntry>::iterator> self_;
@@ -192,9 +271,53 @@ class Connection : public std::enable_shared_from_this<Connection> {
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
   http::response<http::string_body> response_;
+  // An event stream's (see stream()); strand only, except subscription_ set once.
+  std::shared_ptr<EventFeed> feed_;
+  std::uint64_t subscription_ = 0;
+  std::shared_ptr<const std::string> pending_;
+  std::uint64_t sent_sequence_ = 0;
+  bool writing_ = false;
+  bool closed_ = false;
+  std::array<char, 256> ignored_{};
 };
 
 }  // namespace
+
+void EventFeed::publish(std::string message) {
+  std::vector<Waker> wakers;
+  {
+    std::lock_guard lock(mutex_);
+    ++sequence_;
+    latest_ = std::make_shared<const std::string>(std::move(message));
+    for (const auto& [id, waker] : wakers_)
+      wakers.push_back(waker);
+  }
+  // Outside the lock: a waker only posts to its connection's strand.
+  for (const Waker& waker : wakers)
+    waker();
+}
+
+std::size_t EventFeed::subscribers() const {
+  std::lock_guard lock(mutex_);
+  return wakers_.size();
+}
+
+std::pair<std::uint64_t, std::shared_ptr<const std::string>> EventFeed::latest() const {
+  std::lock_guard lock(mutex_);
+  return {sequence_, latest_};
+}
+
+std::uint64_t EventFeed::subscribe(Waker waker) {
+  std::lock_guard lock(mutex_);
+  const std::uint64_t id = next_id_++;
+  wakers_.emplace_back(id, std::move(waker));
+  return id;
+}
+
+void EventFeed::unsubscribe(std::uint64_t id) {
+  std::lock_guard lock(mutex_);
+  std::erase_if(wakers_, [id](const auto& entry) { return entry.first == id; });
+}
 
 void HttpServer::Impl::accept() {
   acceptor.async_accept(asio::make_strand(io), [this](beast::error_code error, tcp::socket socket) {

@@ -253,6 +253,35 @@ TEST_F(DaemonFaults, StatusIsServedAsJsonWhileItRuns) {
   EXPECT_TRUE(status.at("triggers").at("rows").contains("1"));
   EXPECT_GT(status.at("speed").at("max_speed_mps").get<double>(), 0.0);
   EXPECT_TRUE(status.at("disk").contains("free_bytes"));
+  // The page's data: one state per location of the map, in the order of /map, at least one of
+  // them past pending (a plot line came out); the tractor in the map's local frame.
+  const std::string states = status.at("locations").at("states").get<std::string>();
+  ASSERT_EQ(states.size(), 12U) << status.dump();
+  EXPECT_EQ(states.find_first_not_of(".trpmi"), std::string::npos) << states;
+  EXPECT_NE(states.find_first_not_of('.'), std::string::npos) << states;
+  EXPECT_TRUE(status.at("gps").contains("east_m")) << status.dump();
+  const Json map = Json::parse(testing_support::httpGet(port, "/map"));
+  ASSERT_EQ(map.at("locations").size(), 12U);
+  std::ifstream map_csv(field_ / "map.csv");
+  std::string line;
+  std::getline(map_csv, line);  // the header
+  for (const Json& location : map.at("locations")) {
+    ASSERT_TRUE(std::getline(map_csv, line));
+    EXPECT_EQ(line.substr(0, line.find(',')), location.at(0).get<std::string>());
+  }
+  EXPECT_EQ(map.at("locations").at(0).at(2), 0.0);  // the first location is the origin
+  EXPECT_NE(testing_support::httpGet(port, "/").find("<title>fieldrig"), std::string::npos);
+  // The last processed set's six images as JPEG; nothing beyond them.
+  EXPECT_EQ(status.at("thumbnails").at("count"), 6) << status.dump();
+  for (int i = 0; i < 6; ++i) {
+    const std::string jpeg =
+        testing_support::httpGet(port, "/thumbnail/" + std::to_string(i) + ".jpg");
+    ASSERT_GT(jpeg.size(), 100U) << i;
+    EXPECT_EQ(jpeg.substr(0, 3), "\xFF\xD8\xFF") << i;
+  }
+  EXPECT_EQ(testing_support::httpGet(port, "/thumbnail/6.jpg"), "no such image\n");
+  EXPECT_EQ(testing_support::httpGet(port, "/thumbnail/../../etc/passwd").find("root"),
+            std::string::npos);
   EXPECT_EQ(testing_support::httpGet(port, "/healthz"), "ok\n");
   ASSERT_EQ(daemon.waitExit(120s), 0) << daemon.err();
 }

@@ -93,6 +93,22 @@ class HttpClient {
     }
   }
 
+  // For streams (text/event-stream): waits at most `timeout` until what was received since the
+  // last take() contains `needle`; then returns all of it up to and including `needle` and keeps
+  // the rest. "" when it did not come.
+  std::string takeUntil(std::string_view needle, Milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    for (;;) {
+      if (const auto at = received_.find(needle); at != std::string::npos) {
+        std::string taken = received_.substr(0, at + needle.size());
+        received_.erase(0, at + needle.size());
+        return taken;
+      }
+      if (!receive(deadline))
+        return "";
+    }
+  }
+
   // True when the server closes the connection within `timeout` (whatever it sent before).
   bool closedWithin(Milliseconds timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;

@@ -42,6 +42,9 @@ struct AcquisitionOptions {
   recording::WriterOptions writer;
   core::RigLayout layout;  // names the cameras (rig order); cameras beyond it are "cameraN"
   std::size_t processing_queue_sets = 2;
+  // Called on the recorder thread after each set is written (the location's id, empty for a
+  // manual trigger; whether every camera delivered). Must be quick: the recorder waits on it.
+  std::function<void(const std::string& location_id, bool complete)> on_recorded;
 };
 
 struct AcquisitionStats {

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,12 +36,41 @@ struct HttpRequest {
   std::string body;
 };
 
+// A feed of server-sent events (text/event-stream) that replies may open: each stream gets the
+// feed's latest message whenever one is published. A stream that is still writing when more
+// messages arrive gets only the newest afterwards, so a slow client never queues stale states
+// and never holds the publisher up. Thread-safe.
+class EventFeed {
+ public:
+  // `message` is complete SSE text ("event: NAME\ndata: ONE LINE\n\n").
+  void publish(std::string message);
+  std::size_t subscribers() const;
+
+  // For HttpServer's streams: the latest message and its number (0: none yet), and the calls
+  // made (on the publisher's thread) when a new one is published.
+  std::pair<std::uint64_t, std::shared_ptr<const std::string>> latest() const;
+  using Waker = std::function<void()>;
+  std::uint64_t subscribe(Waker waker);
+  void unsubscribe(std::uint64_t id);
+
+ private:
+  mutable std::mutex mutex_;
+  std::uint64_t sequence_ = 0;
+  std::shared_ptr<const std::string> latest_;
+  std::uint64_t next_id_ = 1;
+  std::vector<std::pair<std::uint64_t, Waker>> wakers_;
+};
+
 struct HttpReply {
   boost::beast::http::status status = boost::beast::http::status::ok;
   std::string content_type = "application/json";
   std::string body;
   std::vector<std::pair<std::string, std::string>>
       headers;  // more fields: Allow, Content-Disposition
+  // Set: the reply is an event stream (200, text/event-stream, no length, closed by either
+  // side): `body` is sent first (e.g. "retry: 1000\n\n"), then the feed's messages until the
+  // client goes, a write takes longer than write_timeout, or the server stops.
+  std::shared_ptr<EventFeed> events = nullptr;
 };
 
 struct HttpServerOptions {
