@@ -1,11 +1,16 @@
 #include "fieldrig/daemon/batch_job.h"
 
+#include <fcntl.h>
 #include <openssl/evp.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <set>
@@ -416,6 +421,23 @@ core::Result<BatchTaskSummary> runBatchTask(
   if (task >= plan.tasks.size())
     return core::Error{"task " + std::to_string(task) + " is not in the plan (it has " +
                        std::to_string(plan.tasks.size()) + " tasks)"};
+  // One run of a task at a time, whoever starts it (a Slurm resubmission, `batch run` on a login
+  // node): a second one would append the same plots to the same files. The kernel drops the
+  // lock when the process ends, however it ends.
+  const fs::path task_dir = job_dir / "tasks" / taskDirName(task);
+  std::error_code ec;
+  fs::create_directories(task_dir, ec);
+  const fs::path lock_path = task_dir / ".lock";
+  const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd < 0)
+    return core::Error{lock_path.string() + ": cannot open: " + std::strerror(errno)};
+  struct LockCloser {
+    int fd;
+    ~LockCloser() { ::close(fd); }
+  } closer{lock_fd};
+  if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0)
+    return core::Error{"task " + std::to_string(task) + " is already running (" +
+                       lock_path.string() + " is locked)"};
   using Clock = std::chrono::steady_clock;
   BatchTaskSummary summary;
   pipeline::ProcessorOptions options;

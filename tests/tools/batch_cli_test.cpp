@@ -2,7 +2,10 @@
 // tasks run locally (`batch run --jobs 2`), the merge held against `fieldrig process` run serially
 // on the same sessions, and bad input: a missing session, a session gone after the plan, plots
 // absent from the merge. (tests/tools/batch_slurm_test.sh runs the same plan through real Slurm.)
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/file.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -76,6 +79,17 @@ TEST_F(BatchCli, PlanBalancesSetsNotSessionsAndRefusesAnotherPlanInItsFolder) {
   EXPECT_NE(script.find("batch task '" + job.string() + "' \"$SLURM_ARRAY_TASK_ID\""),
             std::string::npos)
       << script;
+
+  // A task already running (its lock held, here by this test) is not run a second time.
+  fs::create_directories(job / "tasks" / "task-0");
+  const int lock = ::open((job / "tasks" / "task-0" / ".lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(lock, 0);
+  ASSERT_EQ(::flock(lock, LOCK_EX), 0);
+  const auto twice = runFieldrig({"batch", "task", job.string(), "0"}, dir.path());
+  ::close(lock);
+  EXPECT_EQ(twice.exit_code, 3);
+  EXPECT_NE(twice.err.find("task 0 is already running"), std::string::npos) << twice.err;
+  EXPECT_FALSE(fs::exists(job / "tasks" / "task-0" / "0-day-a" / "plots.jsonl"));
 
   // The same plan again is accepted (same hash); another one into the same folder is not.
   const auto again = runFieldrig(plan, dir.path());

@@ -109,11 +109,13 @@ struct SchedulerView {
   std::map<std::size_t, std::string> active;  // task → PENDING, RUNNING…
   std::map<std::size_t, std::string> ended;   // task → sacct's final state (with accounting)
   std::string source;                         // "squeue", "squeue+sacct", "none"
+  bool queue_known = false;                   // squeue answered (or nothing was submitted)
 };
 
 SchedulerView querySlurm(const std::vector<Submission>& submissions) {
   SchedulerView view;
   view.source = "none";
+  view.queue_known = submissions.empty();
   if (submissions.empty())
     return view;
   std::set<std::string> ours;
@@ -129,6 +131,7 @@ SchedulerView querySlurm(const std::vector<Submission>& submissions) {
   const CommandOutput queue = capture("squeue -h -r -o '%i %T'", true);
   if (queue.exit_code == 0) {
     view.source = "squeue";
+    view.queue_known = true;
     for (const daemon::SchedulerTaskState& state : daemon::parseSlurmTaskStates(queue.out)) {
       if (ours.count(state.job_id) && daemon::slurmStateActive(state.state))
         view.active[state.task] = state.state;
@@ -215,6 +218,12 @@ int runSubmit(const BatchArgs& args) {
     return kExitBadInput;
   // A task still queued or running is not submitted again: two copies would write one folder.
   const SchedulerView view = querySlurm(readSubmissions(job_dir));
+  if (!view.queue_known) {
+    return fail(who,
+                "squeue did not answer: cannot tell which tasks still run, so none is "
+                "submitted again",
+                kExitRuntime);
+  }
   std::vector<std::size_t> tasks;
   for (std::size_t task : unfinishedTasks(*plan, job_dir)) {
     if (!view.active.count(task))
