@@ -11,6 +11,7 @@ packages=(
   libdc1394-dev  # the dc1394 driver (IEEE-1394 IIDC cameras); optional: skipped when absent
   libyaml-cpp-dev  # the YAML configuration (config/); dc1394 tests read ROS camera1394 files
   socat          # serial tests run through real pseudo-terminals
+  slurm-wlm munge  # `fieldrig batch` is tested against a real Slurm (slurmctld, slurmd, munged)
   clang libclang-rt-14-dev  # libFuzzer for the NMEA parser fuzz test
   # The aravis driver and its tests (arv-fake-gv-camera-0.8); Debian's aravis-0.8.pc also
   # needs libusb-1.0's .pc file, which libaravis-dev does not pull in.

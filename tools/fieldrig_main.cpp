@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   registerProcessCommand(app, exit_code);
   registerSimulateCommand(app, exit_code);
   registerEvaluateCommand(app, exit_code);
+  registerBatchCommand(app, exit_code);
   // The run functions are CLI11 callbacks, so whatever they let escape arrives there too.
   return runCommandLine(app, "fieldrig", argc, argv, exit_code);
 }

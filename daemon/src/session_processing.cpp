@@ -1,5 +1,7 @@
 #include "fieldrig/daemon/session_processing.h"
 
+#include <algorithm>
+
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
 
@@ -21,7 +23,8 @@ core::Result<SessionProcessingSummary> processSession(
     const std::function<void(const nlohmann::ordered_json&)>& on_line,
     const std::function<void(const std::string&)>& on_problem) {
   SessionProcessingSummary summary;
-  for (std::size_t position = 0; position < reader.sets().size(); ++position) {
+  const std::size_t end = std::min(reader.sets().size(), options.end_position);
+  for (std::size_t position = options.first_position; position < end; ++position) {
     const recording::IndexedSet& set = reader.sets()[position];
     if (position % options.shard_count != options.shard_index)
       continue;

@@ -33,6 +33,8 @@ void registerProcessCommand(CLI::App& app, int& exit_code);
 void registerSimPlotsSubcommand(CLI::App& sim, int& exit_code);
 // `simulate`: a synthetic field (drive, map, session, truth) to replay through fieldrigd.
 void registerSimulateCommand(CLI::App& app, int& exit_code);
+// `batch plan|submit|status|merge|run|task`: sessions reprocessed as a Slurm array job.
+void registerBatchCommand(CLI::App& app, int& exit_code);
 // `evaluate`: plot traits against a synthetic field's truth.
 void registerEvaluateCommand(CLI::App& app, int& exit_code);
 

@@ -25,6 +25,10 @@ struct SessionProcessingOptions {
   // batch job get the same number of sets (±1) whatever the sessions' lengths.
   std::size_t shard_index = 0;
   std::size_t shard_count = 1;
+  // Only the sets at positions [first_position, end_position) of the index: the contiguous part
+  // of a session that one task of a batch plan (daemon/batch_job.h) owns.
+  std::size_t first_position = 0;
+  std::size_t end_position = static_cast<std::size_t>(-1);
   // Also write each set's fused cloud here as PLOT_setN.ply (the processor must keep_cloud).
   std::optional<std::filesystem::path> clouds_dir;
 };
