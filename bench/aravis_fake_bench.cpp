@@ -4,8 +4,12 @@
 // lost and corrupt frames, the slowest trigger() call.
 //
 // With RATE_HZ > 0 the triggers follow a clock instead, as `fieldrig acquire` sends them: then a
-// busy host bunches them, and what counts is that each trigger still gets its own frame
-// (`misnumbered`: whole frames whose camera frame id does not follow their trigger id).
+// busy host bunches them, and what counts is that each trigger still gets its own frame. A
+// trigger the camera merged into the previous one shows no frame-id gap: every later frame then
+// carries an earlier trigger's id, and its trigger-to-frame latency (`latency_ms_p50/p99/max`,
+// from the trigger() call of the id the frame carries to its reception) grows by a trigger
+// period per merge. `misnumbered`: whole frames whose camera frame id does not follow their
+// trigger id.
 // MIN_TRIGGER_INTERVAL_US sets the driver's pacing (default: the camera's frame period; 0: off).
 //
 //   aravis_fake_bench [COUNT=200] [WIDTH=1624] [HEIGHT=1224] [LOST_PER_THOUSAND=0] [RATE_HZ=0]
@@ -73,12 +77,14 @@ int run(int argc, char** argv) {
     } else {
       const auto begin = std::chrono::steady_clock::now();
       std::chrono::nanoseconds slowest{0};
+      std::vector<std::chrono::steady_clock::time_point> sent(static_cast<std::size_t>(count) + 1);
       if (rate_hz > 0) {
         const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
             std::chrono::duration<double>(1.0 / rate_hz));
         for (int i = 1; i <= count; ++i) {
           std::this_thread::sleep_until(begin + (i - 1) * period);
           const auto before = std::chrono::steady_clock::now();
+          sent[static_cast<std::size_t>(i)] = before;
           camera.trigger(static_cast<std::uint64_t>(i));
           slowest = std::max(slowest, std::chrono::steady_clock::now() - before);
         }
@@ -106,13 +112,28 @@ int run(int argc, char** argv) {
         if (m.sequence != expected)
           ++misnumbered;
       }
+      std::vector<double> latency_ms;
+      for (const auto& m : kept) {
+        if (rate_hz > 0 && m.trigger_id >= 1 && m.trigger_id < sent.size()) {
+          latency_ms.push_back(
+              std::chrono::duration<double, std::milli>(m.received.steady - sent[m.trigger_id])
+                  .count());
+        }
+      }
+      std::sort(latency_ms.begin(), latency_ms.end());
+      auto quantile = [&](double q) {
+        return latency_ms.empty() ? 0.0
+                                  : latency_ms[static_cast<std::size_t>(
+                                        q * static_cast<double>(latency_ms.size() - 1))];
+      };
       std::printf(
           "{\"bench\":\"aravis_fake_gv\",\"width\":%u,\"height\":%u,\"lost_per_thousand\":\"%s\","
           "\"triggers\":%d,\"frames\":%llu,\"corrupt\":%llu,\"lost\":%llu,\"failed\":%llu,"
           "\"frames_per_s\":%.2f,\"mb_per_s\":%.1f,\"slowest_trigger_call_us\":%.1f,"
           "\"stream_failures\":%llu,\"stream_underruns\":%llu,\"rate_hz\":%.1f,"
           "\"min_trigger_interval_us\":%lld,\"triggers_paced\":%llu,\"misnumbered\":%llu,"
-          "\"packets_resent\":%llu,\"packets_missing\":%llu}\n",
+          "\"packets_resent\":%llu,\"packets_missing\":%llu,\"latency_ms_p50\":%.1f,"
+          "\"latency_ms_p99\":%.1f,\"latency_ms_max\":%.1f}\n",
           width, height, loss.c_str(), count, static_cast<unsigned long long>(s.frames_delivered),
           static_cast<unsigned long long>(s.frames_corrupt),
           static_cast<unsigned long long>(s.frames_lost),
@@ -126,7 +147,8 @@ int run(int argc, char** argv) {
           static_cast<unsigned long long>(s.triggers_paced),
           static_cast<unsigned long long>(misnumbered),
           static_cast<unsigned long long>(s.packets_resent),
-          static_cast<unsigned long long>(s.packets_missing));
+          static_cast<unsigned long long>(s.packets_missing), quantile(0.5), quantile(0.99),
+          quantile(1.0));
     }
   }
   return rc;

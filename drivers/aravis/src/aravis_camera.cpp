@@ -280,6 +280,7 @@ core::Result<void> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
   issued_ = 0;
   consumed_ = 0;
   last_trigger_acked_ = {};
+  shortest_gap_us_ = -1;
   have_frame_id_ = false;
   external_count_ = 0;
 
@@ -386,6 +387,14 @@ void AravisCamera::issueTrigger(std::uint64_t trigger_id) {
       paced_.fetch_add(1, std::memory_order_relaxed);
       std::this_thread::sleep_until(earliest);
     }
+  }
+  if (last_trigger_acked_ != std::chrono::steady_clock::time_point{}) {
+    const std::int64_t gap_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                                    std::chrono::steady_clock::now() - last_trigger_acked_)
+                                    .count();
+    const std::int64_t shortest = shortest_gap_us_.load(std::memory_order_relaxed);
+    if (shortest < 0 || gap_us < shortest)
+      shortest_gap_us_.store(gap_us, std::memory_order_relaxed);
   }
   issued_ids_[slot % kIssuedRing].store(trigger_id, std::memory_order_relaxed);
   issued_.store(slot + 1, std::memory_order_release);
@@ -538,6 +547,7 @@ AravisStats AravisCamera::stats() const {
   s.packets_missing = packets_missing_;
   s.triggers_paced = paced_.load();
   s.min_trigger_interval_us = min_trigger_interval_.count();
+  s.shortest_trigger_gap_us = shortest_gap_us_.load();
   if (vendor_->stream != nullptr) {
     guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
     arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);

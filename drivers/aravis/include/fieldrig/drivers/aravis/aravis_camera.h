@@ -61,6 +61,8 @@ struct AravisStats {
   std::uint64_t frames_unsolicited = 0;      // arrived with no trigger outstanding; not delivered
   std::uint64_t triggers_paced = 0;          // commands held back to keep the minimum interval
   std::int64_t min_trigger_interval_us = 0;  // the pacing in force (configure's result)
+  // The shortest time from one command's acknowledgement to the next command, -1 before two.
+  std::int64_t shortest_trigger_gap_us = -1;
   // Corrupt frames by Aravis buffer status.
   std::uint64_t status_timeout = 0;
   std::uint64_t status_missing_packets = 0;
@@ -141,6 +143,7 @@ class AravisCamera final : public Camera {
   std::atomic<std::uint64_t> accepted_{0}, refused_{0}, failed_{0}, delivered_{0}, corrupt_{0},
       dropped_{0}, lost_{0}, unsolicited_{0}, timeout_{0}, missing_packets_{0}, size_mismatch_{0},
       other_status_{0}, paced_{0};
+  std::atomic<std::int64_t> shortest_gap_us_{-1};  // trigger worker
   std::uint64_t stream_completed_ = 0, stream_failures_ = 0, stream_underruns_ = 0,  // owner
       packets_resent_ = 0, packets_missing_ = 0;
 };
