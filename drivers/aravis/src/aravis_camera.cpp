@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <mutex>
+#include <thread>
 
 namespace fieldrig::drivers {
 namespace {
@@ -123,7 +125,9 @@ core::Result<void> AravisCamera::configure(const CameraConfig& config) {
   const auto offset_y = unsignedOption(config, "offset_y", 0);
   const auto buffers = unsignedOption(config, "buffers", 8);
   const auto packet_size = unsignedOption(config, "packet_size", 0);
-  for (const auto* option : {&index, &offset_x, &offset_y, &buffers, &packet_size}) {
+  // Read now for its error; the default needs the camera's frame rate (below).
+  const auto min_interval = unsignedOption(config, "min_trigger_interval_us", 0);
+  for (const auto* option : {&index, &offset_x, &offset_y, &buffers, &packet_size, &min_interval}) {
     if (!option->ok())
       return option->error();
   }
@@ -238,7 +242,19 @@ core::Result<void> AravisCamera::configure(const CameraConfig& config) {
                        std::to_string(payload) + " bytes is less than one 8-bit frame"};
   }
 
+  // Pacing: the period of the camera's own frame rate unless the option names one. A camera
+  // without AcquisitionFrameRate is not paced.
+  std::chrono::microseconds pacing{*min_interval};
+  if (config.options.find("min_trigger_interval_us") == config.options.end()) {
+    const double rate = arv_camera_get_frame_rate(camera, &error);
+    g_clear_error(&error);
+    pacing = rate > 0 && rate < 1e6
+                 ? std::chrono::microseconds{static_cast<std::int64_t>(std::ceil(1e6 / rate))}
+                 : std::chrono::microseconds{0};
+  }
+
   config_ = config;
+  min_trigger_interval_ = pacing;
   camera_index_ = *index;
   offset_x_ = *offset_x;
   offset_y_ = *offset_y;
@@ -263,6 +279,8 @@ core::Result<void> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
   sink_ = std::move(sink);
   issued_ = 0;
   consumed_ = 0;
+  last_trigger_acked_ = {};
+  shortest_gap_us_ = -1;
   have_frame_id_ = false;
   external_count_ = 0;
 
@@ -315,12 +333,16 @@ void AravisCamera::stop() {
   if (error != nullptr) {
     spdlog::warn("aravis camera {}: AcquisitionStop: {}", config_.id, takeMessage(error));
   }
-  guint64 completed = 0, failures = 0, underruns = 0;
+  guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
   arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);
+  if (ARV_IS_GV_STREAM(vendor_->stream))
+    arv_gv_stream_get_statistics(ARV_GV_STREAM(vendor_->stream), &resent, &missing);
   vendor_->releaseStream();
   stream_completed_ = completed;
   stream_failures_ = failures;
   stream_underruns_ = underruns;
+  packets_resent_ = resent;
+  packets_missing_ = missing;
   // The stream thread has ended: what is still outstanding will never come.
   lost_.fetch_add(outstandingTriggers(), std::memory_order_relaxed);
   consumed_.store(issued_.load());
@@ -357,10 +379,28 @@ void AravisCamera::issueTrigger(std::uint64_t trigger_id) {
   }
   // Published before the command: a short exposure can bring the frame back before the
   // command's acknowledgement does.
+  // Held back (on this worker, never in trigger()) until the camera can take another trigger.
+  if (min_trigger_interval_.count() > 0 &&
+      last_trigger_acked_ != std::chrono::steady_clock::time_point{}) {
+    const auto earliest = last_trigger_acked_ + min_trigger_interval_;
+    if (std::chrono::steady_clock::now() < earliest) {
+      paced_.fetch_add(1, std::memory_order_relaxed);
+      std::this_thread::sleep_until(earliest);
+    }
+  }
+  if (last_trigger_acked_ != std::chrono::steady_clock::time_point{}) {
+    const std::int64_t gap_us = std::chrono::duration_cast<std::chrono::microseconds>(
+                                    std::chrono::steady_clock::now() - last_trigger_acked_)
+                                    .count();
+    const std::int64_t shortest = shortest_gap_us_.load(std::memory_order_relaxed);
+    if (shortest < 0 || gap_us < shortest)
+      shortest_gap_us_.store(gap_us, std::memory_order_relaxed);
+  }
   issued_ids_[slot % kIssuedRing].store(trigger_id, std::memory_order_relaxed);
   issued_.store(slot + 1, std::memory_order_release);
   GError* error = nullptr;
   arv_camera_software_trigger(vendor_->camera, &error);
+  last_trigger_acked_ = std::chrono::steady_clock::now();
   if (error != nullptr) {
     // The slot stays, marked, so that the next frame is not matched to a trigger never sent.
     issued_ids_[slot % kIssuedRing].store(kFailedTrigger, std::memory_order_release);
@@ -503,12 +543,22 @@ AravisStats AravisCamera::stats() const {
   s.stream_completed = stream_completed_;
   s.stream_failures = stream_failures_;
   s.stream_underruns = stream_underruns_;
+  s.packets_resent = packets_resent_;
+  s.packets_missing = packets_missing_;
+  s.triggers_paced = paced_.load();
+  s.min_trigger_interval_us = min_trigger_interval_.count();
+  s.shortest_trigger_gap_us = shortest_gap_us_.load();
   if (vendor_->stream != nullptr) {
-    guint64 completed = 0, failures = 0, underruns = 0;
+    guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
     arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);
     s.stream_completed = completed;
     s.stream_failures = failures;
     s.stream_underruns = underruns;
+    if (ARV_IS_GV_STREAM(vendor_->stream)) {
+      arv_gv_stream_get_statistics(ARV_GV_STREAM(vendor_->stream), &resent, &missing);
+      s.packets_resent = resent;
+      s.packets_missing = missing;
+    }
   }
   return s;
 }

@@ -15,6 +15,9 @@
 //                         format differently from fieldrig's GenICam name; frames keep `format`
 //   packet_size=BYTES     GigE Vision stream packet size (default: the camera's)
 //   packet_resend=never|always  GigE Vision packet resend requests (default: Aravis' default)
+//   min_trigger_interval_us=US  the shortest time between the acknowledgement of one software
+//                         trigger and the next command (default: one period of the camera's
+//                         AcquisitionFrameRate, 0 when it has none; 0 turns pacing off)
 //
 // Triggers and frames: trigger() only queues the id (lock-free) and wakes the driver's trigger
 // thread, which issues the software trigger (a GVCP register write, a network round trip). Frames
@@ -24,11 +27,19 @@
 // the stream uncounted as frames and counted as unsolicited. With an external trigger, trigger()
 // refuses (false) and frames are numbered 1, 2, … in arrival order, gaps included.
 //
+// Pacing: a camera takes at most one trigger per frame period; a second command inside the same
+// period is merged into the first (arv-fake-gv-camera serves one per 40 ms) and the frame it never
+// sends carries no frame-id gap, so every later frame would be matched to the trigger before its
+// own. Scheduling delays on a busy host bunch triggers that were sent evenly, so the trigger
+// worker holds a command back until min_trigger_interval_us has passed since the previous one was
+// acknowledged; trigger() itself still never waits.
+//
 // Thread contract: configure/start/stop/stats on the owner thread; trigger() on one thread (the
 // trigger thread), never blocks. The FrameSink runs on Aravis' stream thread.
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <thread>
@@ -47,7 +58,11 @@ struct AravisStats {
   std::uint64_t frames_corrupt = 0;     // delivered with status kCorrupt (sum of the reasons below)
   std::uint64_t frames_dropped = 0;     // delivered as kDropped: the frame pool was empty
   std::uint64_t frames_lost = 0;        // triggered, never delivered (frame-id gap, or stop)
-  std::uint64_t frames_unsolicited = 0;  // arrived with no trigger outstanding; not delivered
+  std::uint64_t frames_unsolicited = 0;      // arrived with no trigger outstanding; not delivered
+  std::uint64_t triggers_paced = 0;          // commands held back to keep the minimum interval
+  std::int64_t min_trigger_interval_us = 0;  // the pacing in force (configure's result)
+  // The shortest time from one command's acknowledgement to the next command, -1 before two.
+  std::int64_t shortest_trigger_gap_us = -1;
   // Corrupt frames by Aravis buffer status.
   std::uint64_t status_timeout = 0;
   std::uint64_t status_missing_packets = 0;
@@ -57,6 +72,10 @@ struct AravisStats {
   std::uint64_t stream_completed = 0;
   std::uint64_t stream_failures = 0;
   std::uint64_t stream_underruns = 0;  // a frame came with no free Aravis buffer
+  // GigE Vision only (arv_gv_stream_get_statistics): packets that came back after a resend
+  // request, and packets of failed frames that never came.
+  std::uint64_t packets_resent = 0;
+  std::uint64_t packets_missing = 0;
 };
 
 class AravisCamera final : public Camera {
@@ -99,6 +118,7 @@ class AravisCamera final : public Camera {
   std::uint32_t offset_x_ = 0;
   std::uint32_t offset_y_ = 0;
   std::uint32_t buffer_count_ = 8;
+  std::chrono::microseconds min_trigger_interval_{0};
   std::unique_ptr<Vendor> vendor_;
   core::FramePool* pool_ = nullptr;
   FrameSink sink_;
@@ -111,6 +131,9 @@ class AravisCamera final : public Camera {
   std::atomic<std::uint64_t> issued_{0};                      // slots written (trigger worker)
   std::atomic<std::uint64_t> consumed_{0};  // slots matched or counted lost (stream thread)
 
+  // Trigger worker only: when the previous command was acknowledged.
+  std::chrono::steady_clock::time_point last_trigger_acked_{};
+
   // Stream thread only.
   bool have_frame_id_ = false;
   std::uint64_t last_frame_id_ = 0;
@@ -119,8 +142,10 @@ class AravisCamera final : public Camera {
   // Counters, each written by one thread, read by stats().
   std::atomic<std::uint64_t> accepted_{0}, refused_{0}, failed_{0}, delivered_{0}, corrupt_{0},
       dropped_{0}, lost_{0}, unsolicited_{0}, timeout_{0}, missing_packets_{0}, size_mismatch_{0},
-      other_status_{0};
-  std::uint64_t stream_completed_ = 0, stream_failures_ = 0, stream_underruns_ = 0;  // owner
+      other_status_{0}, paced_{0};
+  std::atomic<std::int64_t> shortest_gap_us_{-1};  // trigger worker
+  std::uint64_t stream_completed_ = 0, stream_failures_ = 0, stream_underruns_ = 0,  // owner
+      packets_resent_ = 0, packets_missing_ = 0;
 };
 
 }  // namespace fieldrig::drivers
