@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   registerTraitsCommand(app, exit_code);
   registerStemCommand(app, exit_code);
   registerStemUiCommand(app, exit_code);
+  registerViewCommand(app, exit_code);
   registerProcessCommand(app, exit_code);
   registerSimulateCommand(app, exit_code);
   registerEvaluateCommand(app, exit_code);

@@ -31,6 +31,7 @@
 #include "fieldrig/daemon/acquisition.h"
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/daemon/results_writer.h"
+#include "fieldrig/daemon/session_view.h"
 #include "fieldrig/daemon/status_server.h"
 #include "fieldrig/gps/local_frame.h"
 #include "fieldrig/gps/location_map.h"
@@ -57,8 +58,9 @@ constexpr auto kFinishTimeout = std::chrono::seconds{10};
 constexpr int kThumbnailWidth = 240;  // pixels: six fit a phone's width in two rows
 
 // A location's state on the page, one character each in the status's locations.states.
-constexpr char kPending = '.', kTriggered = 't', kRecorded = 'r', kProcessed = 'p', kMissed = 'm',
-               kIncomplete = 'i';
+constexpr char kPending = kLocationPending, kTriggered = kLocationTriggered,
+               kRecorded = kLocationRecorded, kProcessed = kLocationProcessed,
+               kMissed = kLocationMissed, kIncomplete = kLocationIncomplete;
 
 struct RowCounts {
   std::uint64_t locations = 0, fired = 0, late = 0, missed = 0;
@@ -153,17 +155,10 @@ class Daemon {
     map_ = std::move(*map);
     frame_.emplace(map_.locations().front().latitude_deg, map_.locations().front().longitude_deg);
     location_states_.assign(map_.size(), kPending);
-    const auto& columns = map_.metadataColumns();
-    const auto row_column = std::find(columns.begin(), columns.end(), "row");
-    for (const auto& location : map_.locations()) {
-      std::string row = "all";
-      if (row_column != columns.end()) {
-        const auto c = static_cast<std::size_t>(row_column - columns.begin());
-        if (c < location.metadata.size())
-          row = location.metadata[c];
-      }
-      location_rows_[location.id] = row;
-      ++rows_[row].locations;
+    const std::vector<std::string> rows = locationRows(map_);
+    for (std::size_t i = 0; i < map_.size(); ++i) {
+      location_rows_[map_.locations()[i].id] = rows[i];
+      ++rows_[rows[i]].locations;
     }
     map_json_ = mapJson();
     max_speed_mps_ = maxSpeedFor(map_, config_.gps.triggers.planner.min_trigger_interval_s);
@@ -647,28 +642,7 @@ class Daemon {
   // The map's static part for the page (/map): each location's id, row and place in metres
   // east and north of the map's first location, in the map's order (that of
   // locations.states in the status).
-  std::string mapJson() const {
-    Json locations = Json::array();
-    for (const auto& location : map_.locations()) {
-      const gps::EnuPoint p = frame_->toLocal(location.latitude_deg, location.longitude_deg);
-      locations.push_back({location.id, location_rows_.at(location.id),
-                           std::round(p.east_m * 100) / 100, std::round(p.north_m * 100) / 100});
-    }
-    return Json{{"map", config_.map.string()},
-                {"origin",
-                 {{"lat", map_.locations().front().latitude_deg},
-                  {"lon", map_.locations().front().longitude_deg}}},
-                {"fields", {"id", "row", "east_m", "north_m"}},
-                {"locations", locations},
-                {"states",
-                 {{std::string(1, kPending), "pending"},
-                  {std::string(1, kTriggered), "triggered"},
-                  {std::string(1, kRecorded), "recorded"},
-                  {std::string(1, kProcessed), "processed"},
-                  {std::string(1, kMissed), "missed"},
-                  {std::string(1, kIncomplete), "incomplete"}}}}
-        .dump();
-  }
+  std::string mapJson() const { return cabMapJson(map_, config_.map.string()).dump(); }
 
   std::string rowOf(const std::string& location_id) const {
     const auto it = location_rows_.find(location_id);

@@ -163,6 +163,8 @@ std::vector<BadInputCase> numberCases() {
        "--drop-factor"},
       {"CloudSetNegative", {"cloud", "{session}", "--set", "-5", "--out", "{out}.ply"}, "--set"},
       {"StemUiPortHuge", {"stem-ui", "{session}", "--port", "70000"}, "--port"},
+      {"ViewPortHuge", {"view", "{session}", "--port", "70000"}, "--port"},
+      {"ViewStemPortZero", {"view", "{session}", "--stem-port", "0"}, "--stem-port"},
       {"MapRecordBaudNan",
        {"map", "record", "--nmea", "{nmea}", "--out", "{out}", "--baud", "nan"},
        "--baud"},

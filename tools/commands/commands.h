@@ -28,6 +28,7 @@ void registerCloudCommand(CLI::App& app, int& exit_code);
 void registerTraitsCommand(CLI::App& app, int& exit_code);
 void registerStemCommand(CLI::App& app, int& exit_code);
 void registerStemUiCommand(CLI::App& app, int& exit_code);
+void registerViewCommand(CLI::App& app, int& exit_code);
 void registerProcessCommand(CLI::App& app, int& exit_code);
 // `sim plots`, added to the `sim` subcommand by registerSimCommand.
 void registerSimPlotsSubcommand(CLI::App& sim, int& exit_code);
