@@ -126,9 +126,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
   const auto rig = fieldrig::cloud::loadRigCalibration(dir);
   if (!rig) {
     const std::string& message = rig.error().message;
-    const bool names_a_file = message.find("rig.yml: ") != std::string::npos ||
-                              message.find("intrinsics.yml: ") != std::string::npos ||
-                              message.find("extrinsics.yml: ") != std::string::npos;
+    // "FILE: …" or "FILE:LINE: …".
+    const bool names_a_file = message.find("rig.yml:") != std::string::npos ||
+                              message.find("intrinsics.yml:") != std::string::npos ||
+                              message.find("extrinsics.yml:") != std::string::npos;
     check(names_a_file, "a rig calibration error that does not name the file: " + message);
     return 0;
   }
