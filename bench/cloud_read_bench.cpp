@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_stats.h"
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/traits/cloud_io.h"
 #include "fieldrig/traits/plot_traits.h"
@@ -46,17 +47,8 @@ double secondsSince(double cpu_start) {
   return processCpuSeconds() - cpu_start;
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values.empty() ? 0.0 : values[values.size() / 2];
-}
-
-std::string loadAverage() {
-  std::ifstream in("/proc/loadavg");
-  std::string a, b, c;
-  in >> a >> b >> c;
-  return a + " " + b + " " + c;
-}
+using fieldrig::bench::loadAverage;
+using fieldrig::bench::median;
 
 // CPU seconds of a `fieldrig --help` process: dynamic loading and static start-up.
 double startupSeconds() {
@@ -79,22 +71,11 @@ double startupSeconds() {
          1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
 
-std::vector<Eigen::Vector3f> pclPly(const std::string& path) {
+// PCL's reader for the file's format, as points.
+std::vector<Eigen::Vector3f> pclRead(const std::string& path) {
   pcl::PointCloud<pcl::PointXYZ> cloud;
-  if (pcl::io::loadPLYFile(path, cloud) < 0) {
-    std::fprintf(stderr, "PCL cannot read %s\n", path.c_str());
-    std::exit(1);
-  }
-  std::vector<Eigen::Vector3f> points;
-  points.reserve(cloud.size());
-  for (const auto& p : cloud)
-    points.emplace_back(p.x, p.y, p.z);
-  return points;
-}
-
-std::vector<Eigen::Vector3f> pclPcd(const std::string& path) {
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  if (pcl::io::loadPCDFile(path, cloud) < 0) {
+  const bool ply = path.ends_with(".ply");
+  if ((ply ? pcl::io::loadPLYFile(path, cloud) : pcl::io::loadPCDFile(path, cloud)) < 0) {
     std::fprintf(stderr, "PCL cannot read %s\n", path.c_str());
     std::exit(1);
   }
@@ -144,12 +125,11 @@ int main(int argc, char** argv) {
   struct Format {
     const char* name;
     std::string path;
-    std::vector<Eigen::Vector3f> (*pcl_reader)(const std::string&);
   };
-  const std::vector<Format> formats = {{"PLY ascii", (dir / "plot_ascii.ply").string(), pclPly},
-                                       {"PLY binary", (dir / "plot_binary.ply").string(), pclPly},
-                                       {"PCD ascii", (dir / "plot_ascii.pcd").string(), pclPcd},
-                                       {"PCD binary", (dir / "plot_binary.pcd").string(), pclPcd}};
+  const std::vector<Format> formats = {{"PLY ascii", (dir / "plot_ascii.ply").string()},
+                                       {"PLY binary", (dir / "plot_binary.ply").string()},
+                                       {"PCD ascii", (dir / "plot_ascii.pcd").string()},
+                                       {"PCD binary", (dir / "plot_binary.pcd").string()}};
   pcl::io::savePLYFile(formats[0].path, cloud, false);
   pcl::io::savePLYFile(formats[1].path, cloud, true);
   pcl::io::savePCDFile(formats[2].path, cloud, false);
@@ -166,7 +146,7 @@ int main(int argc, char** argv) {
       const std::size_t n_ours = ours(format.path).size();
       ours_s.push_back(secondsSince(start));
       start = processCpuSeconds();
-      const std::size_t n_pcl = format.pcl_reader(format.path).size();
+      const std::size_t n_pcl = pclRead(format.path).size();
       pcl_s.push_back(secondsSince(start));
       if (n_ours != kPoints || n_pcl != kPoints) {
         std::fprintf(stderr, "%s: read %zu (fieldrig) and %zu (PCL) points\n", format.name, n_ours,
@@ -207,7 +187,7 @@ int main(int argc, char** argv) {
     traits::computeTraits(a, traits::InputFrame::kPlot, shipped);
     ours_traits.push_back(secondsSince(start));
     start = processCpuSeconds();
-    const std::vector<Eigen::Vector3f> b = pclPly(formats[0].path);
+    const std::vector<Eigen::Vector3f> b = pclRead(formats[0].path);
     paper_read.push_back(secondsSince(start));
     start = processCpuSeconds();
     traits::computeTraits(b, traits::InputFrame::kPlot, paper);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_stats.h"
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/traits/plot_traits.h"
@@ -32,17 +33,8 @@ double relative(double estimate, double truth) {
   return truth != 0.0 ? (estimate - truth) / truth : 0.0;
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values.empty() ? 0.0 : values[values.size() / 2];
-}
-
-std::string loadAverage() {
-  std::ifstream in("/proc/loadavg");
-  std::string a, b, c;
-  in >> a >> b >> c;
-  return a + " " + b + " " + c;
-}
+using fieldrig::bench::loadAverage;
+using fieldrig::bench::median;
 
 }  // namespace
 

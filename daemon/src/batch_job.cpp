@@ -1,7 +1,6 @@
 #include "fieldrig/daemon/batch_job.h"
 
 #include <fcntl.h>
-#include <openssl/evp.h>
 #include <sys/file.h>
 #include <unistd.h>
 
@@ -22,6 +21,7 @@
 #include "fieldrig/daemon/results_writer.h"
 #include "fieldrig/daemon/session_processing.h"
 #include "fieldrig/pipeline/plot_processor.h"
+#include "fieldrig/recording/checksum.h"
 #include "fieldrig/recording/session_format.h"
 #include "fieldrig/recording/session_reader.h"
 #include "fieldrig/traits/plot_report.h"
@@ -31,25 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
-
-std::string sha256Hex(std::string_view bytes) {
-  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> context(EVP_MD_CTX_new(),
-                                                                  &EVP_MD_CTX_free);
-  std::array<unsigned char, EVP_MAX_MD_SIZE> digest{};
-  unsigned int length = 0;
-  if (!context || EVP_DigestInit_ex(context.get(), EVP_sha256(), nullptr) != 1 ||
-      EVP_DigestUpdate(context.get(), bytes.data(), bytes.size()) != 1 ||
-      EVP_DigestFinal_ex(context.get(), digest.data(), &length) != 1) {
-    return {};
-  }
-  std::string hex;
-  char pair[3];
-  for (unsigned int i = 0; i < length; ++i) {
-    std::snprintf(pair, sizeof pair, "%02x", digest[i]);
-    hex += pair;
-  }
-  return hex;
-}
+using recording::sha256Hex;
 
 std::string plotIdOf(const recording::IndexedSet& set) {
   return set.location_id.value_or("set-" + std::to_string(set.set_index));
