@@ -31,6 +31,7 @@
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/traits/cloud_io.h"
 #include "fieldrig/traits/plot_traits.h"
+#include "paper_pipeline.h"
 #include "process_cpu.h"
 
 extern char** environ;
@@ -168,15 +169,7 @@ int main(int argc, char** argv) {
 
   // The whole run on the ASCII PLY.
   traits::TraitsOptions shipped;
-  traits::TraitsOptions paper = shipped;
-  paper.outlier_method = traits::OutlierMethod::kStatistical;
-  paper.outlier_mean_k = 50;
-  paper.template_step_m = 0.01;
-  paper.icp_target_leaf_m = 0.0;
-  paper.icp_fine_distance_m = 0.0;
-  paper.icp_iterations = 30;
-  paper.max_ground_tilt_deg = 90.0;
-  paper.area_method = traits::AreaMethod::kPaperMlsGpt;
+  const traits::TraitsOptions paper = fieldrig::bench::paperPipelineOptions(shipped);
   std::vector<double> ours_read, ours_traits, paper_read, paper_traits;
   const int whole_repeats = std::max(3, repeats / 2);
   for (int r = 0; r < whole_repeats; ++r) {

@@ -15,6 +15,7 @@
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/traits/plot_traits.h"
+#include "paper_pipeline.h"
 
 namespace {
 
@@ -145,17 +146,7 @@ int main(int argc, char** argv) {
   if (cloud.size() < 75905)
     soil.resize(std::min(soil.size(), 75905 - cloud.size()));
   cloud.insert(cloud.end(), soil.begin(), soil.end());
-  // The paper's pipeline: SOR with 50 neighbours, a 1 cm plate registered by one ICP stage with
-  // the 0.3 m correspondence distance, MLS + greedy projection triangulation for the area.
-  traits::TraitsOptions paper = options;
-  paper.outlier_method = traits::OutlierMethod::kStatistical;
-  paper.outlier_mean_k = 50;
-  paper.template_step_m = 0.01;
-  paper.icp_target_leaf_m = 0.0;
-  paper.icp_fine_distance_m = 0.0;
-  paper.icp_iterations = 30;
-  paper.max_ground_tilt_deg = 90.0;
-  paper.area_method = traits::AreaMethod::kPaperMlsGpt;
+  const traits::TraitsOptions paper = fieldrig::bench::paperPipelineOptions(options);
   const int runs = quick ? 2 : 5;
   std::vector<double> ours_ms, paper_ms, filter_ms, ground_ms, slices_ms, hulls_ms, area_ms,
       paper_filter_ms, paper_ground_ms, paper_area_ms;
