@@ -76,7 +76,7 @@ main() {
                core/src/durable_file.cpp)
       includes+=(pipeline/stereo/include pipeline/cloud/include)
       system_includes=(/usr/include/opencv4)
-      libs=(-lopencv_calib3d -lopencv_core)
+      libs=(-lyaml-cpp -lopencv_calib3d -lopencv_core)
       max_len=16384
       ;;
     config_yaml | traits_options)

@@ -245,8 +245,14 @@ std::vector<BadInputCase> damagedFileCases() {
       // OpenCV's parser threw std::length_error through the loader (exit 134).
       {"ProcessRigKeyWithoutName",
        {"process", "{session}", "--calib", "{calib}", "--out", "{out}"},
-       "rig.yml: not a readable OpenCV YAML/XML file",
+       "rig.yml: not a map of fields",
        "%YAML:1.0\n:1.0\n"},
+      // OpenCV's parser looped for ever on this rig.yml (found by the calibration_yaml fuzzer).
+      {"ProcessRigParserLoop",
+       {"process", "{session}", "--calib", "{calib}", "--out", "{out}"},
+       "rig.yml:5: not readable as YAML (illegal map value)",
+       "%YAML:1.0\n---e:as\nhd\n   - bobototm_to_bottomosrotwb\n"
+       "tom_to_bottom: !!ormat: BayerRG8\n"},
   };
 }
 

@@ -1,5 +1,6 @@
 #include "fieldrig/stereo/calibration.h"
 
+#include <yaml-cpp/yaml.h>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -297,17 +298,30 @@ core::Result<void> openCalibrationFile(const std::filesystem::path& file,
       char code[8];
       std::snprintf(code, sizeof code, "0x%02x", byte);
       return Error{file.string() + ":" + std::to_string(line) + ": control character " + code +
-                   ": a damaged file, not OpenCV YAML/XML"};
+                   ": a damaged file, not OpenCV YAML"};
     }
   }
+  // OpenCV's YAML parser loops for ever on some malformed files (fuzzing found one: a "---e:as"
+  // document marker followed by an indented list), so a conforming YAML parser reads the text
+  // first and OpenCV only ever sees well-formed YAML whose top is a map. OpenCV's header
+  // "%YAML:1.0" is not a YAML 1.2 directive: it becomes a comment, keeping the line numbers.
+  if (text.starts_with("%YAML:"))
+    text[0] = '#';
   try {
-    storage.open(file.string(), cv::FileStorage::READ);
+    if (!YAML::Load(text).IsMap())
+      return Error{file.string() + ": not a map of fields (OpenCV YAML)"};
+  } catch (const YAML::Exception& e) {
+    return Error{file.string() + ":" + std::to_string(e.mark.line + 1) +
+                 ": not readable as YAML (" + e.msg + ")"};
+  }
+  try {
+    storage.open(file.string(), cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
     if (!storage.isOpened())
       return Error{file.string() + ": cannot open"};
     if (!storage.root().isMap())
-      return Error{file.string() + ": not a map of fields (OpenCV YAML/XML)"};
+      return Error{file.string() + ": not a map of fields (OpenCV YAML)"};
   } catch (const std::exception& e) {  // cv::Exception, and std::length_error from its parser
-    return Error{file.string() + ": not a readable OpenCV YAML/XML file"};
+    return Error{file.string() + ": not a readable OpenCV YAML file"};
   }
   return {};
 }

@@ -227,7 +227,7 @@ TEST(Rig, HeadNamesAreFolderNamesAndDamagedFilesAreRefused) {
       << twice.error().message;
   const auto not_map = withRig("%YAML:1.0\n- bottom\n- top\n");
   ASSERT_FALSE(not_map);
-  EXPECT_EQ(not_map.error().message, file + ": not a map of fields (OpenCV YAML/XML)");
+  EXPECT_EQ(not_map.error().message, file + ": not a map of fields (OpenCV YAML)");
   const auto huge = withRig(
       "%YAML:1.0\nheads: [ bottom ]\nplot_rotation: !!opencv-matrix\n  rows: 3\n"
       "  cols: 2147483647\n  dt: d\n  data: [ 1 ]\n");

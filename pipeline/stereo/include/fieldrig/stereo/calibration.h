@@ -68,13 +68,15 @@ inline constexpr int kMaxImageSide = 32767;
 inline constexpr double kMinBaselineM = 1e-3;
 inline constexpr double kMaxBaselineM = 10.0;
 
-// OpenCV YAML/XML files as every calibration loader reads them. cv::FileStorage trusts what a file
-// says: `node >> mat` allocates the declared rows x cols before reading the data (16 GiB for
-// "cols: 2147483647"), open() can hang on control bytes and throws std::length_error on some
-// damaged files, and indexing a file whose top is not a map throws. These check first and turn
-// every failure into an error naming the file (and the line or field).
+// OpenCV YAML files as every calibration loader reads them (the project writes YAML; OpenCV's XML
+// is not read). cv::FileStorage trusts what a file says: `node >> mat` allocates the declared
+// rows x cols before reading the data (16 GiB for "cols: 2147483647"), open() hangs on control
+// bytes and on some malformed YAML and throws std::length_error on some damaged files, and
+// indexing a file whose top is not a map throws. These check first and turn every failure into an
+// error naming the file (and the line or field).
 //   openCalibrationFile: a regular file of at most kMaxCalibrationFileBytes, without control
-//     characters other than tab and line breaks, that OpenCV opens as a map of fields.
+//     characters other than tab and line breaks, that yaml-cpp reads as a map (so OpenCV's parser
+//     only meets well-formed YAML) and OpenCV then opens as a map of fields.
 //   readCalibrationMatrix: a 2-D matrix node of at most kMaxCalibrationMatrixSide rows and columns
 //     whose data has rows x cols finite values, as CV_64F; the error says what is wrong with it.
 inline constexpr std::uintmax_t kMaxCalibrationFileBytes = 1 << 20;
