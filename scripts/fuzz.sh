@@ -115,8 +115,8 @@ main() {
                  recording/include drivers/include gps/include pipeline/cloud/include
                  pipeline/traits/include pipeline/processor/include)
       system_includes=(/usr/include/eigen3 /usr/include/pcl-1.13 /usr/include/opencv4)
-      libs=(-lopencv_imgcodecs -lopencv_calib3d -lopencv_imgproc -lopencv_core -lcrypto -lz
-            -lspdlog -lfmt)
+      libs=(-lyaml-cpp -lopencv_imgcodecs -lopencv_calib3d -lopencv_imgproc -lopencv_core
+            -lcrypto -lz -lspdlog -lfmt)
       ;;
   esac
 
