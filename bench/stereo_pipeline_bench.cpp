@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
   std::vector<cloud::HeadFrames> frames;
   for (int i = 0; i < 3; ++i) {
     testing_support::RenderedHead head = testing_support::renderHead(i);
-    frames.push_back({head.left_raw, head.right_raw, core::PixelFormat::kBayerRG8});
+    frames.push_back({head.left_raw, head.right_raw, core::PixelFormat::kBayerRG8, {}, {}});
   }
   std::printf("OpenCV %s, %d threads; %d FrameSets each (after one warm-up), ms per FrameSet\n\n",
               CV_VERSION, cv::getNumThreads(), iterations);

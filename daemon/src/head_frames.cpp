@@ -4,7 +4,10 @@
 #include <span>
 
 #include "fieldrig/core/rig_layout.h"
+#include "fieldrig/stereo/disparity_io.h"
 #include "fieldrig/stereo/preprocess.h"
+
+#include <opencv2/imgcodecs.hpp>
 
 namespace fieldrig::daemon {
 namespace {
@@ -25,7 +28,96 @@ std::vector<cloud::HeadFrames> perHead(const cloud::RigCalibration& rig, Fill fi
   return frames;
 }
 
+// The set's recorded left frame of each head (null where not recorded), in the order of rig.heads.
+std::vector<const recording::IndexedFrame*> leftFrames(const recording::IndexedSet& set,
+                                                       const cloud::RigCalibration& rig) {
+  std::vector<const recording::IndexedFrame*> frames;
+  for (const cloud::HeadCalibration& head : rig.heads) {
+    const std::string camera = core::RigLayout::cameraName(head.name, core::CameraSide::kLeft);
+    const auto it = std::find_if(set.frames.begin(), set.frames.end(),
+                                 [&](const auto& f) { return f.camera_name == camera; });
+    const bool recorded = it != set.frames.end() && it->status == recording::FrameStatus::kOk &&
+                          !it->file.empty() && it->file.ends_with(".pgm");
+    frames.push_back(recorded ? &*it : nullptr);
+  }
+  return frames;
+}
+
+std::vector<std::string> truthSuffixes(TruthMaps maps) {
+  switch (maps) {
+    case TruthMaps::kNone:
+      return {};
+    case TruthMaps::kDepth:
+      return {".depth.pfm"};
+    case TruthMaps::kDepthAndVegetation:
+      return {".depth.pfm", ".veg.png"};
+  }
+  return {};
+}
+
 }  // namespace
+
+std::filesystem::path truthMapPath(const recording::SessionReader& reader,
+                                   const recording::IndexedFrame& frame,
+                                   const std::string& suffix) {
+  std::string file = frame.file;
+  if (file.ends_with(".pgm"))
+    file.resize(file.size() - 4);
+  return reader.dir() / (file + suffix);
+}
+
+core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uint64_t set_index,
+                                const cloud::RigCalibration& rig, TruthMaps maps,
+                                std::vector<cloud::HeadFrames>& frames) {
+  const recording::IndexedSet* set = reader.bySetIndex(set_index);
+  if (!set)
+    return core::Error{reader.dir().string() + ": no set with index " + std::to_string(set_index)};
+  const std::vector<const recording::IndexedFrame*> lefts = leftFrames(*set, rig);
+  for (std::size_t i = 0; i < lefts.size() && i < frames.size(); ++i) {
+    if (!lefts[i])
+      continue;
+    for (const std::string& suffix : truthSuffixes(maps)) {
+      const std::filesystem::path path = truthMapPath(reader, *lefts[i], suffix);
+      if (suffix == ".depth.pfm") {
+        core::Result<cv::Mat> depth = stereo::readPfm(path);
+        if (!depth)
+          return core::Error{"truth depth map " + depth.error().message};
+        frames[i].left_truth_depth = std::move(*depth);
+        continue;
+      }
+      cv::Mat mask;
+      try {
+        mask = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
+      } catch (const cv::Exception&) {
+        mask.release();
+      }
+      if (mask.empty())
+        return core::Error{path.string() + ": truth vegetation mask missing or unreadable"};
+      frames[i].left_truth_vegetation = std::move(mask);
+    }
+  }
+  return {};
+}
+
+core::Result<void> checkTruthMaps(const recording::SessionReader& reader,
+                                  const cloud::RigCalibration& rig, TruthMaps maps) {
+  for (const recording::IndexedSet& set : reader.sets()) {
+    for (const recording::IndexedFrame* left : leftFrames(set, rig)) {
+      if (!left)
+        continue;
+      for (const std::string& suffix : truthSuffixes(maps)) {
+        const std::filesystem::path path = truthMapPath(reader, *left, suffix);
+        std::error_code error;
+        if (!std::filesystem::is_regular_file(path, error)) {
+          return core::Error{path.string() +
+                             ": no truth map (only sessions rendered by `fieldrig simulate` with "
+                             "the mesh renderer have them)"};
+        }
+      }
+    }
+  }
+  return {};
+}
 
 core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
     const recording::SessionReader& reader, std::uint64_t set_index,

@@ -59,13 +59,25 @@ nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::Pl
   line["trigger_status"] = identity.trigger_status;
   line["cloud_points"] = result.cloud_points;
   line["partial"] = result.partial;
+  // Only a line whose depth did not come from stereo says so: the rig's lines stay as they were.
+  if (result.depth_source != cloud::DepthSource::kStereo)
+    line["depth_source"] = cloud::toString(result.depth_source);
   Json heads = Json::array();
   for (const cloud::HeadStatus& head : result.heads) {
-    heads.push_back({{"name", head.name},
-                     {"ok", head.ok},
-                     {"points", head.points},
-                     {"valid_pixel_fraction", head.valid_pixel_fraction},
-                     {"matched_column_fraction", head.matched_column_fraction}});
+    Json head_json = {{"name", head.name},
+                      {"ok", head.ok},
+                      {"points", head.points},
+                      {"valid_pixel_fraction", head.valid_pixel_fraction},
+                      {"matched_column_fraction", head.matched_column_fraction}};
+    if (head.stereo_score) {
+      const stereo::DisparityTruthScore& score = *head.stereo_score;
+      head_json["stereo_vs_truth"] = {{"vegetation_pixels", score.pixels},
+                                      {"matched_fraction", score.matched_fraction},
+                                      {"bad_fraction", score.bad_fraction},
+                                      {"median_abs_depth_error_m", score.median_abs_depth_error_m},
+                                      {"median_depth_error_m", score.median_depth_error_m}};
+    }
+    heads.push_back(std::move(head_json));
   }
   line["heads"] = std::move(heads);
   Json traits_json = traits::traitsToJson(result.traits, /*with_slices=*/false);

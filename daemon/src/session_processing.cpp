@@ -34,6 +34,12 @@ core::Result<SessionProcessingSummary> processSession(
     }
     std::vector<std::string> problems;
     auto frames = headFramesFromRecording(reader, set.set_index, processor.rig(), problems);
+    if (frames && options.truth_maps != TruthMaps::kNone) {
+      if (auto added =
+              addTruthMaps(reader, set.set_index, processor.rig(), options.truth_maps, *frames);
+          !added)
+        return added.error();
+    }
     pipeline::PlotResult result;
     if (frames) {
       result = processor.process(*frames, std::move(problems));

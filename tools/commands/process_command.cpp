@@ -1,9 +1,12 @@
 // `fieldrig process SESSION [--calib DIR] [--map MAP.csv] [--config FILE] [--traits-config FILE]
-//  [--out DIR] [--shard K/N] [--force] [--clouds]`: every FrameSet of a recorded session through
+//  [--out DIR] [--shard K/N] [--force] [--clouds] [--depth-source stereo|truth] [--score-stereo]`:
+//  every FrameSet of a recorded session through
 // the plot processor, the daemon's own (daemon/session_processing.h), into the results folder
 // (plots.jsonl, plots.csv, plots.geojson; daemon/results_writer.h), one JSON line per set on stdout
 // and a summary line last. It resumes: sets already in the folder's plots.jsonl (by trigger id) are
-// skipped unless --force.
+// skipped unless --force. On a session rendered by `fieldrig simulate` (mesh renderer), the depth
+// may come from the rendered truth instead of stereo (--depth-source truth), and stereo may be
+// scored against that truth per head (--score-stereo): bench/attribution_bench.py.
 #include <charconv>
 #include <filesystem>
 #include <iostream>
@@ -27,6 +30,8 @@ using Json = nlohmann::ordered_json;
 
 struct ProcessArgs {
   std::string session, calib, map, config, traits_config, out, shard;
+  std::string depth_source = "stereo";
+  bool score_stereo = false;
   bool clouds = false;
   bool force = false;
 };
@@ -72,6 +77,22 @@ int runProcess(const ProcessArgs& args) {
     if (!loaded)
       return fail(who, loaded.error().message);
     options.traits = *loaded;
+  }
+  if (args.depth_source == "truth") {
+    options.cloud.depth_source = cloud::DepthSource::kTruth;
+    run.truth_maps = daemon::TruthMaps::kDepth;
+  } else if (args.score_stereo) {
+    run.truth_maps = daemon::TruthMaps::kDepthAndVegetation;
+  }
+  if (args.depth_source == "truth" && args.score_stereo) {
+    std::cerr << who << "--score-stereo scores stereo, which --depth-source truth does not run\n";
+    return kExitBadInput;
+  }
+  // Every truth map is checked before anything is written: a session without them is refused
+  // whole, naming the first missing file, rather than failing part-way.
+  if (run.truth_maps != daemon::TruthMaps::kNone) {
+    if (auto present = daemon::checkTruthMaps(reader, *rig, run.truth_maps); !present)
+      return fail(who, present.error().message);
   }
   std::optional<gps::LocationMap> map;
   if (!args.map.empty()) {
@@ -140,6 +161,17 @@ void registerProcessCommand(CLI::App& app, int& exit_code) {
                     "Process every set again (default: resume, skipping the sets already in the "
                     "results)");
   process->add_flag("--clouds", args->clouds, "Also write each set's fused cloud as PLY");
+  process
+      ->add_option("--depth-source", args->depth_source,
+                   "Where each head's depth comes from: stereo (matching, the default) or truth "
+                   "(the left camera's rendered depth map that `fieldrig simulate` writes beside "
+                   "each frame, through the same fusion, crop and traits; result lines say "
+                   "\"depth_source\": \"truth\")")
+      ->check(CLI::IsMember({"stereo", "truth"}));
+  process->add_flag("--score-stereo", args->score_stereo,
+                    "Score each head's stereo against the rendered truth depth (sessions of "
+                    "`fieldrig simulate`): heads[].stereo_vs_truth in each result line, over "
+                    "vegetation pixels within the depth crop; bad = disparity error > 2 px");
 }
 
 }  // namespace fieldrig::tools

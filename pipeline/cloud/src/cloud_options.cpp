@@ -4,6 +4,10 @@
 
 namespace fieldrig::cloud {
 
+const char* toString(DepthSource source) {
+  return source == DepthSource::kTruth ? "truth" : "stereo";
+}
+
 core::Result<void> validate(const CloudOptions& options) {
   using core::Error;
   // Written as negations so that NaN fails every check.

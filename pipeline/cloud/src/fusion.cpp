@@ -147,13 +147,31 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
     // The head checks its input first; an OpenCV failure past those checks still only costs
     // this head, never the FrameSet.
     try {
-      core::Result<stereo::HeadOutput> output = heads_[i].process(
-          frames[i].left, frames[i].right, frames[i].pixel_format, status.name, &status.timings);
+      const HeadFrames& head = frames[i];
+      const bool truth_depth = options_.depth_source == DepthSource::kTruth;
+      if (truth_depth && head.left_truth_depth.empty()) {
+        status.problem = status.name + ": no truth depth map for the left camera";
+        return;
+      }
+      core::Result<stereo::HeadOutput> output =
+          truth_depth ? heads_[i].processTruthDepth(head.left, head.left_truth_depth,
+                                                    head.pixel_format, status.name, &status.timings)
+                      : heads_[i].process(head.left, head.right, head.pixel_format, status.name,
+                                          &status.timings);
       if (!output) {
         status.problem = output.error().message;
         return;
       }
       measureCoverage(output->disparity, status);
+      if (!truth_depth && !head.left_truth_depth.empty() && !head.left_truth_vegetation.empty()) {
+        const stereo::TruthDepthRectifier& truth = heads_[i].truthDepth();
+        core::Result<cv::Mat> truth_disparity = truth.disparity(head.left_truth_depth);
+        core::Result<cv::Mat> vegetation = truth.rectifyMask(head.left_truth_vegetation);
+        if (truth_disparity && vegetation) {
+          status.stereo_score = truth.score(output->disparity, *truth_disparity, *vegetation,
+                                            options_.min_depth_m, options_.max_depth_m);
+        }
+      }
       if (options_.edge_max_jump_px > 0)
         status.edge_pixels = dropDepthEdges(output->disparity, options_.edge_max_jump_px);
       status.points = appendReprojected(

@@ -16,6 +16,7 @@ PlotResult PlotProcessor::process(const std::vector<cloud::HeadFrames>& heads,
                                   std::vector<std::string> problems) {
   PlotResult result;
   result.problems = std::move(problems);
+  result.depth_source = options_.cloud.depth_source;
   const auto cloud_start = std::chrono::steady_clock::now();
   cloud::FusionResult fused = builder_.build(heads);
   result.cloud_ms = core::millisecondsSince(cloud_start);

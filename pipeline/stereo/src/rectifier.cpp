@@ -28,4 +28,9 @@ void Rectifier::rectify(const cv::Mat& left, const cv::Mat& right, cv::Mat& left
   cv::remap(right, right_out, right_map1_, right_map2_, cv::INTER_LINEAR);
 }
 
+void Rectifier::rectifyLeft(const cv::Mat& left, cv::Mat& left_out) const {
+  CV_Assert(left.size() == size_);
+  cv::remap(left, left_out, left_map1_, left_map2_, cv::INTER_LINEAR);
+}
+
 }  // namespace fieldrig::stereo

@@ -25,7 +25,7 @@ std::vector<HeadFrames> renderAll() {
   std::vector<HeadFrames> frames;
   for (int i = 0; i < 3; ++i) {
     RenderedHead head = renderHead(i);
-    frames.push_back({head.left_raw, head.right_raw, core::PixelFormat::kBayerRG8});
+    frames.push_back({head.left_raw, head.right_raw, core::PixelFormat::kBayerRG8, {}, {}});
   }
   return frames;
 }

@@ -23,6 +23,26 @@ core::Result<std::vector<cloud::HeadFrames>> headFramesFromRecording(
     const recording::SessionReader& reader, std::uint64_t set_index,
     const cloud::RigCalibration& rig, std::vector<std::string>& problems);
 
+// What of the simulator's truth maps the left cameras' frames take along (sim/field writes them
+// beside each frame of a rendered session: frames/SSSSSS_C_NAME.depth.pfm and .veg.png for .pgm).
+enum class TruthMaps { kNone, kDepth, kDepthAndVegetation };
+
+// Where the truth map with `suffix` (".depth.pfm", ".veg.png") of a recorded frame is.
+std::filesystem::path truthMapPath(const recording::SessionReader& reader,
+                                   const recording::IndexedFrame& frame, const std::string& suffix);
+
+// Adds the truth maps of each head's left camera in set `set_index` to `frames` (in the order of
+// rig.heads). A head whose left frame was not recorded is skipped (it has no image either). The
+// error names the first file that is missing or unreadable.
+core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uint64_t set_index,
+                                const cloud::RigCalibration& rig, TruthMaps maps,
+                                std::vector<cloud::HeadFrames>& frames);
+
+// Whether every recorded left frame of the session has its truth maps on disk, checked before
+// processing starts; the error names the first missing file and says where they come from.
+core::Result<void> checkTruthMaps(const recording::SessionReader& reader,
+                                  const cloud::RigCalibration& rig, TruthMaps maps);
+
 // The frames of a live set whose camera c is named camera_names[c]. The images point into the
 // set's pool buffers (no copy): keep the set alive while they are used.
 std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,

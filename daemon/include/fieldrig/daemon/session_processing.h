@@ -13,6 +13,7 @@
 #include <string>
 
 #include "fieldrig/core/result.h"
+#include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/daemon/results_writer.h"
 #include "fieldrig/gps/location_map.h"
 #include "fieldrig/pipeline/plot_processor.h"
@@ -31,6 +32,10 @@ struct SessionProcessingOptions {
   std::size_t end_position = static_cast<std::size_t>(-1);
   // Also write each set's fused cloud here as PLOT_setN.ply (the processor must keep_cloud).
   std::optional<std::filesystem::path> clouds_dir;
+  // The simulator's truth maps to hand the processor with each set (head_frames.h): the depth for
+  // cloud::DepthSource::kTruth, depth and vegetation to score stereo. A set whose maps cannot be
+  // read stops the run with an error naming the file (check them first: checkTruthMaps).
+  TruthMaps truth_maps = TruthMaps::kNone;
 };
 
 // Where a run writes its results unless told: SESSION/results, and one shard of several

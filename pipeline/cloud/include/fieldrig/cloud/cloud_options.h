@@ -10,6 +10,14 @@
 
 namespace fieldrig::cloud {
 
+// Where each head's depth comes from: its stereo pair (always, on the rig), or the simulator's
+// rendered truth depth of its left camera (stereo/truth_depth.h), which runs the same chain after
+// matching on perfect disparities: `fieldrig process --depth-source truth`, to tell what stereo
+// costs from what fusion, crop and traits cost. Not a configuration key: no real camera has it.
+enum class DepthSource { kStereo, kTruth };
+
+const char* toString(DepthSource source);
+
 struct CloudOptions {
   double scale = 0.5;  // matching resolution / camera resolution, in (0, 1]
   // The disparity search range at matching resolution is matcher.[min_disparity, min + num).
@@ -21,6 +29,7 @@ struct CloudOptions {
   // disparity — are not reprojected: SGBM blends foreground and background there, and the
   // blend lands as "flying" points between a leaf and what is behind it. 0 keeps them.
   double edge_max_jump_px = 2.0;
+  DepthSource depth_source = DepthSource::kStereo;
 };
 
 // Why `options` cannot be used (naming the field), or nothing.

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,9 +23,14 @@ namespace fieldrig::cloud {
 using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
 
 // One head's frames: raw Bayer (CV_8UC1, of `pixel_format`) or BGR images; empty = missing.
+// The simulator's truth of the left camera may come along (sim/field's maps, camera size):
+// `left_truth_depth` (CV_32F, z in metres) is the depth with DepthSource::kTruth; with kStereo,
+// it and `left_truth_vegetation` (8-bit mask) score the matched disparity
+// (HeadStatus::stereo_score).
 struct HeadFrames {
   cv::Mat left, right;
   core::PixelFormat pixel_format = core::PixelFormat::kBayerRG8;
+  cv::Mat left_truth_depth, left_truth_vegetation;
 };
 
 struct HeadStatus {
@@ -38,6 +44,10 @@ struct HeadStatus {
   // only part of the row shows here, not as a narrower plant.
   double valid_pixel_fraction = 0;
   double matched_column_fraction = 0;
+  // Stereo against the truth, when the truth came with kStereo: over vegetation pixels whose
+  // rectified truth depth lies in (min_depth_m, max_depth_m] (about the plot frame's depth crop),
+  // before the edge filter; bad = |disparity error| > 2 px at matching resolution.
+  std::optional<stereo::DisparityTruthScore> stereo_score;
   stereo::HeadTimings timings;
   double reproject_ms = 0;  // reprojection, transform into the plot frame, crop, colour
 };

@@ -28,8 +28,9 @@ struct PlotResult {
   bool partial = false;                  // some head was left out of the cloud
   std::vector<std::string> problems;     // the adapter's and the heads' problems, in that order
   std::vector<cloud::HeadStatus> heads;  // per head: used or why not, points, coverage
-  cloud::Cloud cloud;                    // only with keep_cloud
-  double cloud_ms = 0;                   // stereo and fusion
+  cloud::DepthSource depth_source = cloud::DepthSource::kStereo;
+  cloud::Cloud cloud;   // only with keep_cloud
+  double cloud_ms = 0;  // stereo and fusion
   double traits_ms = 0;
 };
 

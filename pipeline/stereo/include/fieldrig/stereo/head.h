@@ -11,6 +11,7 @@
 #include "fieldrig/stereo/calibration.h"
 #include "fieldrig/stereo/matcher.h"
 #include "fieldrig/stereo/rectifier.h"
+#include "fieldrig/stereo/truth_depth.h"
 
 namespace fieldrig::stereo {
 
@@ -46,19 +47,35 @@ class HeadPipeline {
                                    core::PixelFormat format, const std::string& name,
                                    HeadTimings* timings = nullptr);
 
+  // The same output with the disparity made from the left camera's rendered truth depth
+  // (`raw_left_depth`, CV_32F at camera size; truth_depth.h) instead of matching: the left image
+  // is checked, debayered, scaled and rectified as by process(); no right image is needed.
+  core::Result<HeadOutput> processTruthDepth(const cv::Mat& raw_left, const cv::Mat& raw_left_depth,
+                                             core::PixelFormat format, const std::string& name,
+                                             HeadTimings* timings = nullptr);
+
+  // Turns truth maps onto this head's rectified grid and scores disparities against them.
+  const TruthDepthRectifier& truthDepth() const { return truth_depth_; }
+
   // The calibration at matching resolution (Q reprojects this head's disparities).
   const StereoCalibration& matchingCalibration() const { return scaled_; }
 
  private:
-  HeadPipeline(const StereoCalibration& scaled, Rectifier rectifier, const HeadOptions& options)
+  HeadPipeline(const StereoCalibration& scaled, Rectifier rectifier,
+               TruthDepthRectifier truth_depth, const HeadOptions& options)
       : scaled_(scaled),
         rectifier_(std::move(rectifier)),
+        truth_depth_(std::move(truth_depth)),
         options_(options),
         matcher_(options.matcher) {}
+
+  core::Result<void> checkImage(const cv::Mat& raw, const char* side,
+                                const std::string& name) const;
 
   StereoCalibration scaled_;
   cv::Size camera_size_;
   Rectifier rectifier_;
+  TruthDepthRectifier truth_depth_;
   HeadOptions options_;
   DisparityMatcher matcher_;
 };

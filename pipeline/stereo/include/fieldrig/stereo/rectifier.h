@@ -18,6 +18,8 @@ class Rectifier {
   // Remaps both images (any type remap accepts); their size must be size().
   void rectify(const cv::Mat& left, const cv::Mat& right, cv::Mat& left_out,
                cv::Mat& right_out) const;
+  // The left image only (its depth comes from elsewhere: truth_depth.h).
+  void rectifyLeft(const cv::Mat& left, cv::Mat& left_out) const;
   cv::Size size() const { return size_; }
 
  private:

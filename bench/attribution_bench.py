@@ -1,0 +1,219 @@
+#!/usr/bin/env python3
+"""Where the trait error comes from on the rendered mesh field (issue 11): stereo, or fusion, crop
+and traits.
+
+Makes (or reuses) a synthetic field as bench/mesh_field_bench.py does (`fieldrig simulate --plots N
+--rows R --stage early,mid,mature --seed S`) and processes its session twice with the same
+`fieldrig process` chain, differing only in where each head's depth comes from:
+  (a) the truth: traits by their definitions on the plants' mesh surfaces that some camera sees
+      (DIR/truth.jsonl; meshPlotTruth). Everything is measured against it, so it is the zero row;
+      "(a') full geometry" shows what the view itself hides (the truth's `full` block: the same
+      definitions on all of the plot's surfaces, seen or not).
+  (b) `--depth-source truth`: each head's left camera's rendered truth depth map (beside every
+      frame) as its disparity → the same edge filter, reprojection, fusion, crop and traits.
+  (b') as (b) with the depth-edge filter off (the shipped config/fieldrigd.yaml with
+      pipeline.cloud.edge_max_jump_px 0; left out when --process-args names a --config): what
+      that filter costs with perfect depth, where it drops the outermost leaf edges.
+  (c) stereo (SGBM, the rig's path), with `--score-stereo`.
+(b) − (a) is what fusion, crop and the traits code cost with perfect depth; (c) − (b) is what
+stereo costs. Per trait: mean absolute error, worst, bias (heights and widths in cm, VVI and VAI
+relative to the truth). Per head, stereo against the per-pixel truth on vegetation pixels whose
+truth depth lies inside the depth crop: the fraction matched, the bad-pixel rate (|disparity
+error| > 2 px at matching resolution, of the matched ones) and the median depth error; and each
+head's points in the fused cloud from (b) and (c). The last line is one JSON summary.
+
+Usage: bench/attribution_bench.py [BUILD_DIR] [--plots 8] [--rows 2] [--seed 11] [--out DIR]
+       [--process-args ARGS]
+With --out the field and results stay in DIR and a field already there is reused (delete it to
+remake); without it they go to a temporary folder. Rendering takes ~5-10 s a plot on 2 cores.
+"""
+import argparse
+import json
+import os
+import re
+import shlex
+import statistics
+import subprocess
+import sys
+import tempfile
+
+TRAITS = [("height_m", "height", "m"), ("width_m", "width", "m"), ("vvi", "VVI", ""),
+          ("vai", "VAI", "")]
+
+
+def stats(pairs, relative):
+    """pairs: (measured, truth); errors in the unit, or relative (fraction of truth)."""
+    errors = [((m - t) / t if relative else m - t) for m, t in pairs
+              if t and m is not None]
+    if not errors:
+        return None
+    return {"n": len(errors), "mean_abs": sum(abs(e) for e in errors) / len(errors),
+            "max_abs": max(abs(e) for e in errors), "bias": sum(errors) / len(errors)}
+
+
+def fmt(value, relative, signed=False):
+    text = f"{100 * value:+.1f} {'%' if relative else 'cm'}"
+    return text if signed else text[1:]
+
+
+def read_results(path):
+    lines = {}
+    with open(path) as f:
+        for line in f:
+            j = json.loads(line)
+            lines[j["plot"]] = j
+    return lines
+
+
+def process(fieldrig, field, out, extra, process_args):
+    subprocess.run([fieldrig, "process", os.path.join(field, "source-session"), "--map",
+                    os.path.join(field, "map.csv"), "--out", out, "--force"] + extra +
+                   shlex.split(process_args), check=True, stdout=subprocess.DEVNULL)
+    return read_results(os.path.join(out, "plots.jsonl"))
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("build", nargs="?", default="build")
+    parser.add_argument("--plots", type=int, default=8)
+    parser.add_argument("--rows", type=int, default=2)
+    parser.add_argument("--seed", type=int, default=11)
+    parser.add_argument("--out")
+    parser.add_argument("--process-args", default="")
+    args = parser.parse_args()
+    fieldrig = os.path.join(args.build, "tools", "fieldrig")
+    work = args.out or tempfile.mkdtemp(prefix="attribution_bench_")
+    field = os.path.join(work, "field")
+    if not os.path.exists(os.path.join(field, "truth.jsonl")):
+        subprocess.run([fieldrig, "simulate", "--plots", str(args.plots), "--rows", str(args.rows),
+                        "--seed", str(args.seed), "--stage", "early,mid,mature", "--out", field],
+                       check=True, stdout=subprocess.DEVNULL)
+    truth = {}
+    with open(os.path.join(field, "truth.jsonl")) as f:
+        for line in f:
+            j = json.loads(line)
+            truth[j["plot"]] = j
+    from_truth = process(fieldrig, field, os.path.join(work, "results-truth-depth"),
+                         ["--depth-source", "truth"], args.process_args)
+    from_truth_no_edges = None
+    if "--config" not in args.process_args:
+        shipped = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config",
+                               "fieldrigd.yaml")
+        with open(shipped) as f:
+            text, replaced = re.subn(r"edge_max_jump_px: *[0-9.]+", "edge_max_jump_px: 0",
+                                     f.read())
+        if replaced != 1:
+            sys.exit(f"{shipped}: expected one edge_max_jump_px, found {replaced}")
+        no_edges = os.path.join(work, "no-edge-filter.yaml")
+        with open(no_edges, "w") as f:
+            f.write(text)
+        from_truth_no_edges = process(fieldrig, field,
+                                      os.path.join(work, "results-truth-depth-no-edge-filter"),
+                                      ["--depth-source", "truth", "--config", no_edges],
+                                      args.process_args)
+    from_stereo = process(fieldrig, field, os.path.join(work, "results-stereo"),
+                          ["--score-stereo"], args.process_args)
+    for name, results in (("truth depth", from_truth), ("stereo", from_stereo)):
+        for plot in results:
+            if plot not in truth:
+                sys.exit(f"{plot} ({name}): not in the truth")
+    plots = sorted(truth, key=lambda p: truth[p]["set"])
+
+    print("| plot | stage | plants m | width m: truth | (a') full | (b) truth depth | "
+          "(b') no edge filter | (c) stereo |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    for p in plots:
+        t = truth[p]
+        cells = [from_truth.get(p, {}).get("traits", {}).get("width_m"),
+                 (from_truth_no_edges or {}).get(p, {}).get("traits", {}).get("width_m"),
+                 from_stereo.get(p, {}).get("traits", {}).get("width_m")]
+        full = t.get("full", {}).get("width_m")
+        print(f"| {p} | {t.get('stage', '?')} | {t['plant_height_m']:.2f} | {t['width_m']:.3f} | "
+              + " | ".join("—" if v is None else f"{v:.3f}" for v in [full] + cells) + " |")
+
+    rows = [
+        ("(a) mesh truth (seen surfaces)", {p: truth[p] for p in plots}),
+        ("(a') full geometry, seen or not", {p: truth[p].get("full", {}) for p in plots}),
+        ("(b) truth depth → fusion → traits", {p: from_truth.get(p, {}).get("traits", {})
+                                               for p in plots}),
+        ("(b') truth depth, no edge filter", {p: (from_truth_no_edges or {}).get(p, {})
+                                             .get("traits", {}) for p in plots}),
+        ("(c) SGBM → fusion → traits", {p: from_stereo.get(p, {}).get("traits", {})
+                                        for p in plots}),
+    ]
+    summary = {"plots": len(plots), "rows": {}}
+    print(f"\nAgainst the mesh truth, {len(plots)} plots: mean abs / worst / bias")
+    print("| row | " + " | ".join(name for _, name, _ in TRAITS) + " |")
+    print("| --- |" + " --- |" * len(TRAITS))
+    for label, measured in rows:
+        cells, row_summary = [], {}
+        for key, _, unit in TRAITS:
+            relative = unit == ""
+            s = stats([(measured[p].get(key), truth[p][key]) for p in plots], relative)
+            row_summary[key] = s
+            cells.append("—" if s is None else
+                         f"{fmt(s['mean_abs'], relative)} / {fmt(s['max_abs'], relative)} / "
+                         f"{fmt(s['bias'], relative, True)}")
+        summary["rows"][label.split(" ")[0]] = row_summary
+        print(f"| {label} | " + " | ".join(cells) + " |")
+    b, c = summary["rows"]["(b)"], summary["rows"]["(c)"]
+    cost = {}
+    cells = []
+    for key, _, unit in TRAITS:
+        relative = unit == ""
+        if b.get(key) and c.get(key):
+            cost[key] = {"mean_abs": c[key]["mean_abs"] - b[key]["mean_abs"],
+                         "bias": c[key]["bias"] - b[key]["bias"]}
+            cells.append(f"{fmt(cost[key]['mean_abs'], relative, True)} mean abs, "
+                         f"{fmt(cost[key]['bias'], relative, True)} bias")
+        else:
+            cells.append("—")
+    summary["stereo_cost"] = cost
+    print("| stereo's share, (c) − (b) | " + " | ".join(cells) + " |")
+
+    print("\nPer head, stereo against the per-pixel truth (vegetation pixels inside the depth crop; "
+          "bad = |disparity error| > 2 px at matching resolution, of the matched pixels); "
+          "points in the fused cloud")
+    print("| head | plots seen | vegetation px | matched | bad | median abs depth error | "
+          "median depth error | points (b) | points (c) |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    heads = {}
+    for p in plots:
+        for head in from_stereo.get(p, {}).get("heads", []):
+            h = heads.setdefault(head["name"], {"plots": 0, "pixels": 0, "matched": 0.0,
+                                                "bad": 0.0, "abs": [], "signed": [],
+                                                "points_b": 0, "points_c": 0})
+            h["points_c"] += head.get("points", 0)
+            score = head.get("stereo_vs_truth")
+            if not score or not score["vegetation_pixels"]:
+                continue
+            n = score["vegetation_pixels"]
+            h["plots"] += 1
+            h["pixels"] += n
+            h["matched"] += score["matched_fraction"] * n
+            h["bad"] += score["bad_fraction"] * score["matched_fraction"] * n
+            h["abs"].append(score["median_abs_depth_error_m"])
+            h["signed"].append(score["median_depth_error_m"])
+        for head in from_truth.get(p, {}).get("heads", []):
+            if head["name"] in heads:
+                heads[head["name"]]["points_b"] += head.get("points", 0)
+    summary["heads"] = {}
+    for name, h in heads.items():
+        matched = h["matched"] / h["pixels"] if h["pixels"] else 0.0
+        bad = h["bad"] / h["matched"] if h["matched"] else 0.0
+        med_abs = statistics.median(h["abs"]) if h["abs"] else 0.0
+        med = statistics.median(h["signed"]) if h["signed"] else 0.0
+        summary["heads"][name] = {"plots": h["plots"], "vegetation_pixels": h["pixels"],
+                                  "matched_fraction": matched, "bad_fraction": bad,
+                                  "median_abs_depth_error_m": med_abs,
+                                  "median_depth_error_m": med, "points_truth_depth": h["points_b"],
+                                  "points_stereo": h["points_c"]}
+        print(f"| {name} | {h['plots']} | {h['pixels']} | {100 * matched:.1f} % | "
+              f"{100 * bad:.1f} % | {1000 * med_abs:.1f} mm | {1000 * med:+.1f} mm | "
+              f"{h['points_b']} | {h['points_c']} |")
+    print("(depth errors: the median over plots of each plot's median)")
+    print(json.dumps({"summary": summary}))
+
+
+if __name__ == "__main__":
+    main()

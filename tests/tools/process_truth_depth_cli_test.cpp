@@ -1,0 +1,128 @@
+// `fieldrig process --depth-source truth` and `--score-stereo` on sessions of `fieldrig sim plots`:
+// a rendered mesh plot processed from its truth depth maps goes through the same fusion, crop and
+// traits as stereo, with every left pixel measured; stereo is scored per head against the same
+// truth; a session without the truth maps is refused before anything is written, naming the file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "support/cli_run.h"
+#include "support/temp_dir.h"
+
+namespace fieldrig {
+namespace {
+
+using testing_support::readWholeFile;
+using testing_support::runFieldrig;
+using testing_support::ScopedTempDir;
+using Json = nlohmann::json;
+namespace fs = std::filesystem;
+
+// The one result line of a one-set run (the summary comes last).
+Json plotLine(const testing_support::CliRun& run) {
+  EXPECT_EQ(run.out_lines.size(), 2U) << run.err;
+  return run.out_lines.empty() ? Json() : Json::parse(run.out_lines.front());
+}
+
+const Json& head(const Json& line, const std::string& name) {
+  for (const Json& h : line.at("heads")) {
+    if (h.at("name") == name)
+      return h;
+  }
+  ADD_FAILURE() << "no head " << name << " in " << line.dump();
+  static const Json none;
+  return none;
+}
+
+TEST(ProcessTruthDepthCli, TruthDepthGoesThroughTheSameChainAndStereoIsScoredAgainstIt) {
+  ScopedTempDir dir("process_truth_depth");
+  const fs::path session = dir / "session";
+  const auto made = runFieldrig(
+      {"sim", "plots", "--out", session.string(), "--count", "1", "--stage", "mid"}, dir.path());
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const Json truth = Json::parse(readWholeFile(session / "truth.jsonl"));
+
+  const auto stereo = runFieldrig(
+      {"process", session.string(), "--out", (dir / "stereo").string(), "--score-stereo"},
+      dir.path());
+  ASSERT_EQ(stereo.exit_code, 0) << stereo.err;
+  const auto from_truth = runFieldrig(
+      {"process", session.string(), "--out", (dir / "truth").string(), "--depth-source", "truth"},
+      dir.path());
+  ASSERT_EQ(from_truth.exit_code, 0) << from_truth.err;
+  const Json s = plotLine(stereo);
+  const Json t = plotLine(from_truth);
+  ASSERT_FALSE(s.is_null());
+  ASSERT_FALSE(t.is_null());
+  EXPECT_FALSE(s.contains("depth_source")) << "a stereo line stays as the rig writes it";
+  EXPECT_EQ(t.at("depth_source"), "truth");
+  EXPECT_EQ(t.at("traits").at("status"), "ok") << t.dump();
+  EXPECT_EQ(t.at("problems"), Json::array()) << t.dump();
+
+  // Perfect depth: every plant pixel of the bottom head has a disparity, so its share of the left
+  // image and its cloud exceed what matching (left–right check, speckle filter) keeps.
+  const Json& stereo_bottom = head(s, "bottom");
+  const Json& truth_bottom = head(t, "bottom");
+  EXPECT_GT(truth_bottom.at("valid_pixel_fraction").get<double>(),
+            stereo_bottom.at("valid_pixel_fraction").get<double>());
+  EXPECT_GT(truth_bottom.at("points").get<std::size_t>(),
+            stereo_bottom.at("points").get<std::size_t>());
+  EXPECT_FALSE(truth_bottom.contains("stereo_vs_truth"));
+
+  // The truth-depth height is as close to the mesh truth as stereo's, give or take the slicing
+  // (1 cm voxels): it has the same crop and slices and no matching error.
+  const double truth_height = truth.at("height_m").get<double>();
+  const double error_truth_depth =
+      std::abs(t.at("traits").at("height_m").get<double>() - truth_height);
+  const double error_stereo = std::abs(s.at("traits").at("height_m").get<double>() - truth_height);
+  EXPECT_LE(error_truth_depth, error_stereo + 0.02)
+      << "truth depth " << error_truth_depth << " m, stereo " << error_stereo << " m";
+  EXPECT_LT(error_truth_depth, 0.05);
+
+  // Stereo scored on the plot's vegetation: a matched share, a bad-pixel rate, and a depth error of
+  // millimetres (the rig's SGBM at 0.8-1.7 m), not of the metre a wrong convention would give.
+  const Json& score = stereo_bottom.at("stereo_vs_truth");
+  EXPECT_GT(score.at("vegetation_pixels").get<std::size_t>(), 10000U) << score.dump();
+  const double matched = score.at("matched_fraction").get<double>();
+  const double bad = score.at("bad_fraction").get<double>();
+  EXPECT_GT(matched, 0.2) << score.dump();
+  EXPECT_LE(matched, 1.0);
+  EXPECT_GE(bad, 0.0);
+  EXPECT_LT(bad, 0.5) << score.dump();
+  EXPECT_LT(score.at("median_abs_depth_error_m").get<double>(), 0.02) << score.dump();
+  EXPECT_LT(std::abs(score.at("median_depth_error_m").get<double>()), 0.02) << score.dump();
+}
+
+TEST(ProcessTruthDepthCli, ASessionWithoutTruthMapsIsRefusedNamingTheMissingFile) {
+  ScopedTempDir dir("process_truth_depth_missing");
+  const fs::path session = dir / "session";
+  // The splat renderer writes no truth maps.
+  const auto made =
+      runFieldrig({"sim", "plots", "--out", session.string(), "--count", "1"}, dir.path());
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  for (const auto& extra : {std::vector<std::string>{"--depth-source", "truth"},
+                            std::vector<std::string>{"--score-stereo"}}) {
+    std::vector<std::string> args = {"process", session.string(), "--out",
+                                     (dir / "results").string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto run = runFieldrig(args, dir.path());
+    SCOPED_TRACE(extra.front());
+    EXPECT_EQ(run.exit_code, 2) << run.err;
+    EXPECT_NE(run.err.find("frames/000000_0_bottom_left.depth.pfm"), std::string::npos) << run.err;
+    EXPECT_FALSE(fs::exists(dir / "results")) << "something was written";
+  }
+  const auto both = runFieldrig(
+      {"process", session.string(), "--depth-source", "truth", "--score-stereo"}, dir.path());
+  EXPECT_EQ(both.exit_code, 2);
+  EXPECT_NE(both.err.find("--score-stereo"), std::string::npos) << both.err;
+  const auto bogus =
+      runFieldrig({"process", session.string(), "--depth-source", "lidar"}, dir.path());
+  EXPECT_EQ(bogus.exit_code, 2);
+  EXPECT_NE(bogus.err.find("--depth-source"), std::string::npos) << bogus.err;
+}
+
+}  // namespace
+}  // namespace fieldrig
