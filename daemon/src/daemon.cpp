@@ -78,6 +78,24 @@ std::pair<double, double> memoryMb() {
   return {rss, static_cast<double>(usage.ru_maxrss) / 1e3};
 }
 
+// The status's "packets": GigE Vision packets resent on request and missing for good (their
+// frames are damaged), in total and per camera. A count no camera's transport has (sim, 1394) is
+// null: not known, which is not the same as none lost.
+Json packetsJson(const LinkSummary& link) {
+  auto known = [&](bool has, std::uint64_t count) { return has ? Json(count) : Json(nullptr); };
+  Json cameras = Json::object();
+  for (const LinkSummary::Camera& camera : link.cameras) {
+    cameras[camera.name] = {
+        {"resent", known(camera.link.has_packets, camera.link.packets_resent)},
+        {"missing", known(camera.link.has_packets, camera.link.packets_missing)},
+        {"frames_missing_packets", camera.link.frames_missing_packets}};
+  }
+  return {{"resent", known(link.has_packets, link.packets_resent)},
+          {"missing", known(link.has_packets, link.packets_missing)},
+          {"frames_missing_packets", link.frames_missing_packets},
+          {"cameras", cameras}};
+}
+
 std::string nowIso() {
   return core::formatIso8601(core::UtcTime{std::chrono::duration_cast<core::Nanoseconds>(
                                  std::chrono::system_clock::now().time_since_epoch())},
@@ -727,6 +745,7 @@ class Daemon {
                    {"frames_dropped", stats.rig.frames_dropped},
                    {"frames_corrupt", stats.rig.frames_corrupt},
                    {"recording_stopped", stats.recording_stopped}};
+    out["packets"] = packetsJson(acquisition_->linkSummary());
     {
       std::lock_guard thumbnails_lock(thumbnails_mutex_);
       out["thumbnails"] = {{"set", thumbnails_set_}, {"count", thumbnails_.size()}};
@@ -775,6 +794,9 @@ class Daemon {
     summary["sets_lost"] = stats.sets_lost;
     summary["sets_processed"] = stats.sets_processed;
     summary["sets_skipped_for_processing"] = stats.sets_skipped_for_processing;
+    const LinkSummary link = acquisition_->linkSummary();
+    summary["packets_resent"] = link.has_packets ? Json(link.packets_resent) : Json(nullptr);
+    summary["packets_missing"] = link.has_packets ? Json(link.packets_missing) : Json(nullptr);
     summary["recording_stopped"] = stats.recording_stopped;
     summary["alarms"] = alarms_total_;
     // How the run went on this machine (not results: they vary from run to run).

@@ -254,6 +254,7 @@ core::Result<void> AravisCamera::configure(const CameraConfig& config) {
   }
 
   config_ = config;
+  gv_device_ = arv_camera_is_gv_device(camera) != FALSE;
   min_trigger_interval_ = pacing;
   camera_index_ = *index;
   offset_x_ = *offset_x;
@@ -284,7 +285,10 @@ core::Result<void> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
   have_frame_id_ = false;
   external_count_ = 0;
 
-  vendor_->stream = arv_camera_create_stream(camera, nullptr, nullptr, &error);
+  {
+    std::lock_guard lock(stream_mutex_);
+    vendor_->stream = arv_camera_create_stream(camera, nullptr, nullptr, &error);
+  }
   if (vendor_->stream == nullptr) {
     return core::Error{"aravis camera " + config_.id +
                        ": cannot create the stream: " + takeMessage(error)};
@@ -310,6 +314,7 @@ core::Result<void> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
   arv_camera_start_acquisition(camera, &error);
   if (error != nullptr) {
     running_ = false;
+    std::lock_guard lock(stream_mutex_);
     vendor_->releaseStream();
     return featureError(config_, "AcquisitionStart", error);
   }
@@ -333,16 +338,21 @@ void AravisCamera::stop() {
   if (error != nullptr) {
     spdlog::warn("aravis camera {}: AcquisitionStop: {}", config_.id, takeMessage(error));
   }
-  guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
-  arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);
-  if (ARV_IS_GV_STREAM(vendor_->stream))
-    arv_gv_stream_get_statistics(ARV_GV_STREAM(vendor_->stream), &resent, &missing);
-  vendor_->releaseStream();
-  stream_completed_ = completed;
-  stream_failures_ = failures;
-  stream_underruns_ = underruns;
-  packets_resent_ = resent;
-  packets_missing_ = missing;
+  {
+    // Readers on other threads wait out the release (it joins the stream thread) and then see
+    // the totals instead of the stream.
+    std::lock_guard lock(stream_mutex_);
+    guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
+    arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);
+    if (ARV_IS_GV_STREAM(vendor_->stream))
+      arv_gv_stream_get_statistics(ARV_GV_STREAM(vendor_->stream), &resent, &missing);
+    vendor_->releaseStream();
+    stream_completed_ = completed;
+    stream_failures_ = failures;
+    stream_underruns_ = underruns;
+    packets_resent_ = resent;
+    packets_missing_ = missing;
+  }
   // The stream thread has ended: what is still outstanding will never come.
   lost_.fetch_add(outstandingTriggers(), std::memory_order_relaxed);
   consumed_.store(issued_.load());
@@ -540,14 +550,15 @@ AravisStats AravisCamera::stats() const {
   s.status_missing_packets = missing_packets_.load();
   s.status_size_mismatch = size_mismatch_.load();
   s.status_other = other_status_.load();
+  s.triggers_paced = paced_.load();
+  s.min_trigger_interval_us = min_trigger_interval_.count();
+  s.shortest_trigger_gap_us = shortest_gap_us_.load();
+  std::lock_guard lock(stream_mutex_);
   s.stream_completed = stream_completed_;
   s.stream_failures = stream_failures_;
   s.stream_underruns = stream_underruns_;
   s.packets_resent = packets_resent_;
   s.packets_missing = packets_missing_;
-  s.triggers_paced = paced_.load();
-  s.min_trigger_interval_us = min_trigger_interval_.count();
-  s.shortest_trigger_gap_us = shortest_gap_us_.load();
   if (vendor_->stream != nullptr) {
     guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
     arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);
@@ -561,6 +572,16 @@ AravisStats AravisCamera::stats() const {
     }
   }
   return s;
+}
+
+CameraLinkStats AravisCamera::linkStats() const {
+  const AravisStats s = stats();
+  CameraLinkStats link;
+  link.has_packets = gv_device_.load();
+  link.packets_resent = s.packets_resent;
+  link.packets_missing = s.packets_missing;
+  link.frames_missing_packets = s.status_missing_packets;
+  return link;
 }
 
 }  // namespace fieldrig::drivers

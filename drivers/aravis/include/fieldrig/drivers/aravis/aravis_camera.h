@@ -34,14 +34,17 @@
 // worker holds a command back until min_trigger_interval_us has passed since the previous one was
 // acknowledged; trigger() itself still never waits.
 //
-// Thread contract: configure/start/stop/stats on the owner thread; trigger() on one thread (the
-// trigger thread), never blocks. The FrameSink runs on Aravis' stream thread.
+// Thread contract: configure/start/stop on the owner thread; trigger() on one thread (the
+// trigger thread), never blocks; stats() and linkStats() from any thread (a mutex the frame path
+// never takes keeps the stream alive while they read it). The FrameSink runs on Aravis' stream
+// thread.
 #pragma once
 
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <thread>
 
 #include "fieldrig/core/spsc_queue.h"
@@ -92,6 +95,9 @@ class AravisCamera final : public Camera {
   bool trigger(std::uint64_t trigger_id) override;
 
   AravisStats stats() const;
+  // packets_resent and packets_missing of a GigE Vision stream, and the frames marked for missing
+  // packets; has_packets is false for a USB3 Vision or in-process fake camera.
+  CameraLinkStats linkStats() const override;
 
  private:
   struct Vendor;  // the Aravis objects; defined where arv.h is included
@@ -144,8 +150,12 @@ class AravisCamera final : public Camera {
       dropped_{0}, lost_{0}, unsolicited_{0}, timeout_{0}, missing_packets_{0}, size_mismatch_{0},
       other_status_{0}, paced_{0};
   std::atomic<std::int64_t> shortest_gap_us_{-1};  // trigger worker
-  std::uint64_t stream_completed_ = 0, stream_failures_ = 0, stream_underruns_ = 0,  // owner
-      packets_resent_ = 0, packets_missing_ = 0;
+  std::atomic<bool> gv_device_{false};             // configure's camera speaks GigE Vision
+  // Guards vendor_->stream's lifetime (start creates it, stop releases it) against readers on
+  // other threads, and the totals the owner keeps from the last stop().
+  mutable std::mutex stream_mutex_;
+  std::uint64_t stream_completed_ = 0, stream_failures_ = 0, stream_underruns_ = 0,
+                packets_resent_ = 0, packets_missing_ = 0;
 };
 
 }  // namespace fieldrig::drivers
