@@ -30,6 +30,7 @@
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/acquisition.h"
 #include "fieldrig/daemon/head_frames.h"
+#include "fieldrig/daemon/link_status.h"
 #include "fieldrig/daemon/results_writer.h"
 #include "fieldrig/daemon/session_view.h"
 #include "fieldrig/daemon/status_server.h"
@@ -76,24 +77,6 @@ std::pair<double, double> memoryMb() {
   rusage usage{};
   ::getrusage(RUSAGE_SELF, &usage);
   return {rss, static_cast<double>(usage.ru_maxrss) / 1e3};
-}
-
-// The status's "packets": GigE Vision packets resent on request and missing for good (their
-// frames are damaged), in total and per camera. A count no camera's transport has (sim, 1394) is
-// null: not known, which is not the same as none lost.
-Json packetsJson(const LinkSummary& link) {
-  auto known = [&](bool has, std::uint64_t count) { return has ? Json(count) : Json(nullptr); };
-  Json cameras = Json::object();
-  for (const LinkSummary::Camera& camera : link.cameras) {
-    cameras[camera.name] = {
-        {"resent", known(camera.link.has_packets, camera.link.packets_resent)},
-        {"missing", known(camera.link.has_packets, camera.link.packets_missing)},
-        {"frames_missing_packets", camera.link.frames_missing_packets}};
-  }
-  return {{"resent", known(link.has_packets, link.packets_resent)},
-          {"missing", known(link.has_packets, link.packets_missing)},
-          {"frames_missing_packets", link.frames_missing_packets},
-          {"cameras", cameras}};
 }
 
 std::string nowIso() {
@@ -745,7 +728,7 @@ class Daemon {
                    {"frames_dropped", stats.rig.frames_dropped},
                    {"frames_corrupt", stats.rig.frames_corrupt},
                    {"recording_stopped", stats.recording_stopped}};
-    out["packets"] = packetsJson(acquisition_->linkSummary());
+    out["packets"] = linkStatusJson(acquisition_->linkSummary());
     {
       std::lock_guard thumbnails_lock(thumbnails_mutex_);
       out["thumbnails"] = {{"set", thumbnails_set_}, {"count", thumbnails_.size()}};
