@@ -38,9 +38,10 @@
 //
 // Pacing: a camera takes at most one trigger per frame period; a second command inside the same
 // period is merged into the first (arv-fake-gv-camera serves one per 40 ms) and the frame it never
-// sends carries no frame-id gap, so every later frame would be matched to the trigger before its
-// own. Scheduling delays on a busy host bunch triggers that were sent evenly, so the trigger
-// worker holds a command back until min_trigger_interval_us has passed since the previous one was
+// sends carries no frame-id gap: matched by time the merged trigger is counted lost, matched in
+// order every later frame would take the trigger before its own; either way it has no frame.
+// Scheduling delays on a busy host bunch triggers that were sent evenly, so the trigger worker
+// holds a command back until min_trigger_interval_us has passed since the previous one was
 // acknowledged; trigger() itself still never waits.
 //
 // Thread contract: configure/start/stop on the owner thread; trigger() on one thread (the
