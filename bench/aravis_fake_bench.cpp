@@ -5,11 +5,13 @@
 //
 // With RATE_HZ > 0 the triggers follow a clock instead, as `fieldrig acquire` sends them: then a
 // busy host bunches them, and what counts is that each trigger still gets its own frame. A
-// trigger the camera merged into the previous one shows no frame-id gap: every later frame then
-// carries an earlier trigger's id, and its trigger-to-frame latency (`latency_ms_p50/p99/max`,
-// from the trigger() call of the id the frame carries to its reception) grows by a trigger
-// period per merge. `misnumbered`: whole frames whose camera frame id does not follow their
-// trigger id.
+// trigger the camera merged into the previous one shows no frame-id gap. Matched in order, every
+// later frame would carry an earlier trigger's id and its trigger-to-frame latency
+// (`latency_ms_p50/p99/max`, from the trigger() call of the id the frame carries to its
+// reception) would grow by a trigger period per merge; matched by time (the fake stamps with the
+// host's clock: `matched_by_time`), the merge is counted (`triggers_merged`, also in `lost`) and
+// later frames keep their own ids. `misnumbered`: whole frames whose camera frame id does not
+// follow their trigger id (after a merge, every later one: the camera skipped no frame id).
 // MIN_TRIGGER_INTERVAL_US sets the driver's pacing (default: the camera's frame period; 0: off).
 //
 //   aravis_fake_bench [COUNT=200] [WIDTH=1624] [HEIGHT=1224] [LOST_PER_THOUSAND=0] [RATE_HZ=0]
@@ -131,7 +133,8 @@ int run(int argc, char** argv) {
           "\"triggers\":%d,\"frames\":%llu,\"corrupt\":%llu,\"lost\":%llu,\"failed\":%llu,"
           "\"frames_per_s\":%.2f,\"mb_per_s\":%.1f,\"slowest_trigger_call_us\":%.1f,"
           "\"stream_failures\":%llu,\"stream_underruns\":%llu,\"rate_hz\":%.1f,"
-          "\"min_trigger_interval_us\":%lld,\"triggers_paced\":%llu,\"misnumbered\":%llu,"
+          "\"min_trigger_interval_us\":%lld,\"triggers_paced\":%llu,\"triggers_merged\":%llu,"
+          "\"matched_by_time\":%llu,\"misnumbered\":%llu,"
           "\"packets_resent\":%llu,\"packets_missing\":%llu,\"latency_ms_p50\":%.1f,"
           "\"latency_ms_p99\":%.1f,\"latency_ms_max\":%.1f}\n",
           width, height, loss.c_str(), count, static_cast<unsigned long long>(s.frames_delivered),
@@ -145,6 +148,8 @@ int run(int argc, char** argv) {
           static_cast<unsigned long long>(s.stream_underruns), rate_hz,
           static_cast<long long>(s.min_trigger_interval_us),
           static_cast<unsigned long long>(s.triggers_paced),
+          static_cast<unsigned long long>(s.triggers_merged),
+          static_cast<unsigned long long>(s.frames_matched_by_time),
           static_cast<unsigned long long>(misnumbered),
           static_cast<unsigned long long>(s.packets_resent),
           static_cast<unsigned long long>(s.packets_missing), quantile(0.5), quantile(0.99),

@@ -262,4 +262,21 @@ AcquisitionStats Acquisition::stats() const {
   return s;
 }
 
+LinkSummary Acquisition::linkSummary() const {
+  LinkSummary summary;
+  const std::vector<drivers::CameraLinkStats> links = rig_->cameraLinkStats();
+  for (std::size_t i = 0; i < links.size(); ++i) {
+    const drivers::CameraLinkStats& link = links[i];
+    if (link.has_packets) {
+      summary.has_packets = true;
+      summary.packets_resent += link.packets_resent;
+      summary.packets_missing += link.packets_missing;
+      summary.frames_missing_packets += link.frames_missing_packets;
+    }
+    summary.cameras.push_back(
+        {i < camera_names_.size() ? camera_names_[i] : "camera" + std::to_string(i), link});
+  }
+  return summary;
+}
+
 }  // namespace fieldrig::daemon

@@ -30,6 +30,7 @@
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/acquisition.h"
 #include "fieldrig/daemon/head_frames.h"
+#include "fieldrig/daemon/link_status.h"
 #include "fieldrig/daemon/results_writer.h"
 #include "fieldrig/daemon/session_view.h"
 #include "fieldrig/daemon/status_server.h"
@@ -727,6 +728,7 @@ class Daemon {
                    {"frames_dropped", stats.rig.frames_dropped},
                    {"frames_corrupt", stats.rig.frames_corrupt},
                    {"recording_stopped", stats.recording_stopped}};
+    out["packets"] = linkStatusJson(acquisition_->linkSummary());
     {
       std::lock_guard thumbnails_lock(thumbnails_mutex_);
       out["thumbnails"] = {{"set", thumbnails_set_}, {"count", thumbnails_.size()}};
@@ -775,6 +777,9 @@ class Daemon {
     summary["sets_lost"] = stats.sets_lost;
     summary["sets_processed"] = stats.sets_processed;
     summary["sets_skipped_for_processing"] = stats.sets_skipped_for_processing;
+    const LinkSummary link = acquisition_->linkSummary();
+    summary["packets_resent"] = link.has_packets ? Json(link.packets_resent) : Json(nullptr);
+    summary["packets_missing"] = link.has_packets ? Json(link.packets_missing) : Json(nullptr);
     summary["recording_stopped"] = stats.recording_stopped;
     summary["alarms"] = alarms_total_;
     // How the run went on this machine (not results: they vary from run to run).

@@ -191,4 +191,12 @@ RigStats Rig::stats() const {
   return s;
 }
 
+std::vector<CameraLinkStats> Rig::cameraLinkStats() const {
+  std::vector<CameraLinkStats> links;
+  links.reserve(cameras_.size());
+  for (const auto& camera : cameras_)
+    links.push_back(camera->linkStats());
+  return links;
+}
+
 }  // namespace fieldrig::drivers

@@ -167,6 +167,13 @@ TEST(DaemonLive, GpsLossAndSerialUnplugAreAlarmedSurvivedAndRecovered) {
   EXPECT_GT(along_sigma, 0.001) << last.dump();
   EXPECT_LT(along_sigma, 0.05) << last.dump();
   EXPECT_NEAR(timing_sigma * 2.0, along_sigma, along_sigma * 0.3) << last.dump();
+  // Six sim cameras: no packets, so the GigE Vision counts are not known (null), per camera too.
+  const Json packets = final_status.at("packets");
+  EXPECT_TRUE(packets.at("resent").is_null()) << packets.dump();
+  EXPECT_TRUE(packets.at("missing").is_null()) << packets.dump();
+  ASSERT_EQ(packets.at("cameras").size(), 6u) << packets.dump();
+  for (const auto& [name, camera] : packets.at("cameras").items())
+    EXPECT_TRUE(camera.at("resent").is_null()) << name;
   ASSERT_TRUE(daemon.signal(SIGTERM));
   ASSERT_EQ(daemon.waitExit(30s), 0) << daemon.err();
 

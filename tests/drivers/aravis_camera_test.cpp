@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstring>
+#include <thread>
 #include <vector>
 
 #include "fieldrig/drivers/rig.h"
@@ -99,6 +101,8 @@ TEST(AravisCameraTest, InProcessFakeGivesOneFramePerTrigger) {
   EXPECT_EQ(stats.frames_delivered, std::uint64_t{kTriggers});
   EXPECT_EQ(stats.frames_lost, 0u);
   EXPECT_LT(triggered.slowest, 10ms) << "trigger() must only queue";
+  // The in-process fake is no GigE Vision device: it has no packets to count.
+  EXPECT_FALSE(camera->linkStats().has_packets);
 }
 
 TEST(AravisCameraTest, RigOfTwoInProcessFakes) {
@@ -350,6 +354,124 @@ TEST_F(AravisGigETest, PacketLossIsCountedNeverBlocks) {
               frames.size(), static_cast<unsigned long long>(stats.frames_corrupt),
               static_cast<unsigned long long>(stats.frames_lost),
               static_cast<unsigned long long>(stats.stream_failures));
+}
+
+// The generic link counters (Camera::linkStats, what `fieldrig acquire` and the daemon's status
+// report) against the fake losing 1 % of its packets with Aravis' default resend: they are the
+// GigE Vision stream's own counts, and reading them from another thread while the camera starts,
+// runs and stops is safe (the status server does so).
+TEST_F(AravisGigETest, LinkStatsCountPacketsAndAreReadableFromAnyThread) {
+  FakeGvCamera fake("10");
+  auto camera = createAravis();
+  ASSERT_TRUE(camera);
+  const auto configured = configureWhenUp(*camera, cameraConfig(fake.address()), fake);
+  ASSERT_TRUE(configured.ok()) << configured.error().message;
+  EXPECT_TRUE(camera->linkStats().has_packets);
+  std::atomic<bool> reading{true};
+  std::atomic<std::uint64_t> reads{0};
+  std::thread reader([&] {
+    while (reading) {
+      const CameraLinkStats link = camera->linkStats();
+      EXPECT_TRUE(link.has_packets);
+      reads.fetch_add(1);
+    }
+  });
+  const auto pool = core::FramePool::create(16, std::size_t{kWidth} * kHeight).value();
+  Collector collector;
+  ASSERT_TRUE(camera->start(*pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
+  constexpr int kTriggers = 60;
+  const auto triggered = triggerInStep(*camera, collector, kTriggers, 500ms);
+  camera->stop();
+  reading = false;
+  reader.join();
+  EXPECT_EQ(triggered.refused, 0);
+  EXPECT_GT(reads.load(), 0u);
+
+  const AravisStats stats = dynamic_cast<AravisCamera&>(*camera).stats();
+  const CameraLinkStats link = camera->linkStats();
+  EXPECT_TRUE(link.has_packets);
+  EXPECT_EQ(link.packets_resent, stats.packets_resent);
+  EXPECT_EQ(link.packets_missing, stats.packets_missing);
+  EXPECT_EQ(link.frames_missing_packets, stats.status_missing_packets);
+  // 60 frames of ~55 packets at 1 %: about 33 packets lost, each resent or counted missing.
+  EXPECT_GT(link.packets_resent + link.packets_missing, 0u);
+  std::printf(
+      "packet loss 1%%, resend on: %llu resent, %llu missing, %llu frames damaged, "
+      "%llu lost, %zu delivered\n",
+      static_cast<unsigned long long>(link.packets_resent),
+      static_cast<unsigned long long>(link.packets_missing),
+      static_cast<unsigned long long>(stats.frames_corrupt),
+      static_cast<unsigned long long>(stats.frames_lost), collector.size());
+}
+
+// Triggers merged by the camera never shift later frames' ids. Pacing off, triggers go out in
+// bursts of three back to back: the fake polls its trigger once per 40 ms, so a burst is mostly
+// one exposure. Each burst waits for its frames, so every frame is exposed after its burst was
+// sent and before the next one: the burst whose send time last precedes a frame's device
+// timestamp (the fake stamps with the host's clock) is the truth, and the frame's trigger id must
+// belong to it. Matched in order, the first merge would give every later frame an id of the
+// burst before.
+TEST_F(AravisGigETest, MergedTriggersNeverShiftLaterFramesIds) {
+  FakeGvCamera fake;
+  auto camera = createAravis();
+  ASSERT_TRUE(camera);
+  CameraConfig config = cameraConfig(fake.address());
+  config.options["min_trigger_interval_us"] = "0";
+  const auto configured = configureWhenUp(*camera, config, fake);
+  ASSERT_TRUE(configured.ok()) << configured.error().message;
+  auto& aravis = dynamic_cast<AravisCamera&>(*camera);
+  const auto pool = core::FramePool::create(16, std::size_t{kWidth} * kHeight).value();
+  Collector collector;
+  ASSERT_TRUE(camera->start(*pool, collector.sinkKeeping<core::Frame>(keepHead)).ok());
+  constexpr int kBursts = 15;
+  constexpr int kPerBurst = 3;
+  std::vector<std::int64_t> burst_sent_ns;
+  for (int burst = 0; burst < kBursts; ++burst) {
+    const std::size_t before = collector.size();
+    burst_sent_ns.push_back(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                std::chrono::system_clock::now().time_since_epoch())
+                                .count());
+    for (int k = 1; k <= kPerBurst; ++k)
+      EXPECT_TRUE(camera->trigger(static_cast<std::uint64_t>(burst * kPerBurst + k)));
+    collector.waitFor(before + 1, 1s);
+    std::this_thread::sleep_for(150ms);  // room for a second exposure of the burst, if any
+  }
+  camera->stop();
+
+  const auto frames = collector.items();
+  const AravisStats stats = aravis.stats();
+  EXPECT_EQ(stats.triggers_accepted, std::uint64_t{kBursts * kPerBurst});
+  EXPECT_EQ(stats.frames_delivered + stats.frames_lost + stats.triggers_failed,
+            std::uint64_t{kBursts * kPerBurst});
+  EXPECT_EQ(frames.size(), stats.frames_delivered);
+  EXPECT_LE(stats.triggers_merged, stats.frames_lost);
+  EXPECT_GT(stats.triggers_merged, 0u) << "no burst was merged: the test provoked nothing";
+  // Every whole frame of the fake carries the host's clock: all were matched by time.
+  std::uint64_t whole = 0;
+  for (const Seen& frame : frames)
+    whole += frame.metadata.status == core::FrameStatus::kOk ? 1 : 0;
+  EXPECT_EQ(stats.frames_matched_by_time, whole);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const core::FrameMetadata& m = frames[i].metadata;
+    if (i > 0) {
+      EXPECT_GT(m.trigger_id, frames[i - 1].metadata.trigger_id);
+    }
+    const auto burst_of_id = static_cast<std::size_t>((m.trigger_id - 1) / kPerBurst);
+    const auto next =
+        std::upper_bound(burst_sent_ns.begin(), burst_sent_ns.end(), m.device_timestamp_ns);
+    ASSERT_NE(next, burst_sent_ns.begin()) << "frame exposed before the first trigger";
+    const auto burst_of_exposure = static_cast<std::size_t>(next - burst_sent_ns.begin() - 1);
+    EXPECT_EQ(burst_of_id, burst_of_exposure)
+        << "frame " << i << " (frame id " << m.sequence << ") carries trigger " << m.trigger_id
+        << " of burst " << burst_of_id << " but was exposed in burst " << burst_of_exposure;
+  }
+  std::printf(
+      "bursts of %d unpaced triggers: %zu frames of %d triggers, %llu merged, %llu lost, "
+      "%llu unsolicited\n",
+      kPerBurst, frames.size(), kBursts * kPerBurst,
+      static_cast<unsigned long long>(stats.triggers_merged),
+      static_cast<unsigned long long>(stats.frames_lost),
+      static_cast<unsigned long long>(stats.frames_unsolicited));
 }
 
 }  // namespace

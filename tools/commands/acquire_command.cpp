@@ -114,6 +114,11 @@ int runAcquire(const AcquireArgs& args) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   const double cpu = cpuSeconds() - cpu_before;
   const daemon::AcquisitionStats s = (*acquisition)->stats();
+  const daemon::LinkSummary link = (*acquisition)->linkSummary();
+  // Not known (null) unless some camera's transport has packets (GigE Vision).
+  auto packets = [&](std::uint64_t count) {
+    return link.has_packets ? Json(count) : Json(nullptr);
+  };
 
   Json summary;
   summary["sets"] = s.sets_recorded;
@@ -124,6 +129,8 @@ int runAcquire(const AcquireArgs& args) {
   summary["frames_corrupt"] = s.rig.frames_corrupt;
   summary["max_skew_us"] = static_cast<double>(s.rig.max_skew_ns) / 1000.0;
   summary["skew_flagged"] = s.rig.skew_flagged;
+  summary["packets_resent"] = packets(link.packets_resent);
+  summary["packets_missing"] = packets(link.packets_missing);
   summary["mb_per_s"] = static_cast<double>(s.bytes_written) / 1e6 / seconds;
   summary["sets_per_s"] = static_cast<double>(s.sets_recorded) / seconds;
   summary["cpu_ms_per_set"] =

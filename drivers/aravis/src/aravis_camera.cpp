@@ -59,6 +59,19 @@ std::uint64_t frameIdGap(std::uint64_t last, std::uint64_t id) {
   return 1;
 }
 
+// The host's real-time clock, the clock of device timestamps that are synchronised with it.
+std::int64_t realtimeNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// A device timestamp is taken to be on the host's clock when it is at most this far after the
+// frame's arrival (clock steps and sync error) and at most kStampAge before it (a frame's
+// exposure, transfer and a stalled host).
+constexpr std::int64_t kStampAheadNs = 20'000'000;
+constexpr std::int64_t kStampAgeNs = 10'000'000'000;
+
 // Enables the in-process fake interface once: Aravis keeps it enabled for the process.
 void enableFakeInterface() {
   static std::once_flag once;
@@ -108,7 +121,9 @@ struct AravisCallbacks {
 
 AravisCamera::AravisCamera()
     : vendor_(std::make_unique<Vendor>()),
-      issued_ids_(std::make_unique<std::atomic<std::uint64_t>[]>(kIssuedRing)) {}
+      issued_ids_(std::make_unique<std::atomic<std::uint64_t>[]>(kIssuedRing)),
+      issued_sent_ns_(std::make_unique<std::atomic<std::int64_t>[]>(kIssuedRing)),
+      issued_acked_ns_(std::make_unique<std::atomic<std::int64_t>[]>(kIssuedRing)) {}
 
 AravisCamera::~AravisCamera() {
   stop();
@@ -254,6 +269,7 @@ core::Result<void> AravisCamera::configure(const CameraConfig& config) {
   }
 
   config_ = config;
+  gv_device_ = arv_camera_is_gv_device(camera) != FALSE;
   min_trigger_interval_ = pacing;
   camera_index_ = *index;
   offset_x_ = *offset_x;
@@ -284,7 +300,10 @@ core::Result<void> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
   have_frame_id_ = false;
   external_count_ = 0;
 
-  vendor_->stream = arv_camera_create_stream(camera, nullptr, nullptr, &error);
+  {
+    std::lock_guard lock(stream_mutex_);
+    vendor_->stream = arv_camera_create_stream(camera, nullptr, nullptr, &error);
+  }
   if (vendor_->stream == nullptr) {
     return core::Error{"aravis camera " + config_.id +
                        ": cannot create the stream: " + takeMessage(error)};
@@ -310,6 +329,7 @@ core::Result<void> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
   arv_camera_start_acquisition(camera, &error);
   if (error != nullptr) {
     running_ = false;
+    std::lock_guard lock(stream_mutex_);
     vendor_->releaseStream();
     return featureError(config_, "AcquisitionStart", error);
   }
@@ -333,16 +353,21 @@ void AravisCamera::stop() {
   if (error != nullptr) {
     spdlog::warn("aravis camera {}: AcquisitionStop: {}", config_.id, takeMessage(error));
   }
-  guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
-  arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);
-  if (ARV_IS_GV_STREAM(vendor_->stream))
-    arv_gv_stream_get_statistics(ARV_GV_STREAM(vendor_->stream), &resent, &missing);
-  vendor_->releaseStream();
-  stream_completed_ = completed;
-  stream_failures_ = failures;
-  stream_underruns_ = underruns;
-  packets_resent_ = resent;
-  packets_missing_ = missing;
+  {
+    // Readers on other threads wait out the release (it joins the stream thread) and then see
+    // the totals instead of the stream.
+    std::lock_guard lock(stream_mutex_);
+    guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
+    arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);
+    if (ARV_IS_GV_STREAM(vendor_->stream))
+      arv_gv_stream_get_statistics(ARV_GV_STREAM(vendor_->stream), &resent, &missing);
+    vendor_->releaseStream();
+    stream_completed_ = completed;
+    stream_failures_ = failures;
+    stream_underruns_ = underruns;
+    packets_resent_ = resent;
+    packets_missing_ = missing;
+  }
   // The stream thread has ended: what is still outstanding will never come.
   lost_.fetch_add(outstandingTriggers(), std::memory_order_relaxed);
   consumed_.store(issued_.load());
@@ -397,10 +422,13 @@ void AravisCamera::issueTrigger(std::uint64_t trigger_id) {
       shortest_gap_us_.store(gap_us, std::memory_order_relaxed);
   }
   issued_ids_[slot % kIssuedRing].store(trigger_id, std::memory_order_relaxed);
+  issued_acked_ns_[slot % kIssuedRing].store(kNotAcked, std::memory_order_relaxed);
+  issued_sent_ns_[slot % kIssuedRing].store(realtimeNs(), std::memory_order_relaxed);
   issued_.store(slot + 1, std::memory_order_release);
   GError* error = nullptr;
   arv_camera_software_trigger(vendor_->camera, &error);
   last_trigger_acked_ = std::chrono::steady_clock::now();
+  issued_acked_ns_[slot % kIssuedRing].store(realtimeNs(), std::memory_order_release);
   if (error != nullptr) {
     // The slot stays, marked, so that the next frame is not matched to a trigger never sent.
     issued_ids_[slot % kIssuedRing].store(kFailedTrigger, std::memory_order_release);
@@ -410,7 +438,8 @@ void AravisCamera::issueTrigger(std::uint64_t trigger_id) {
   }
 }
 
-bool AravisCamera::matchTrigger(std::uint64_t gap, std::uint64_t& trigger_id) {
+bool AravisCamera::matchTrigger(std::uint64_t gap, std::optional<std::int64_t> exposed_ns,
+                                std::uint64_t& trigger_id) {
   const std::uint64_t issued = issued_.load(std::memory_order_acquire);
   std::uint64_t consumed = consumed_.load(std::memory_order_relaxed);
   auto skipFailed = [&] {
@@ -428,10 +457,33 @@ bool AravisCamera::matchTrigger(std::uint64_t gap, std::uint64_t& trigger_id) {
   }
   skipFailed();
   bool matched = false;
-  if (consumed < issued) {
+  if (consumed < issued && !exposed_ns) {
     trigger_id = issued_ids_[consumed % kIssuedRing].load(std::memory_order_relaxed);
     ++consumed;
     matched = true;
+  } else if (consumed < issued && issued_sent_ns_[consumed % kIssuedRing].load(
+                                      std::memory_order_relaxed) <= *exposed_ns) {
+    trigger_id = issued_ids_[consumed % kIssuedRing].load(std::memory_order_relaxed);
+    ++consumed;
+    matched = true;
+    matched_by_time_.fetch_add(1, std::memory_order_relaxed);
+    // The camera exposes once for all the triggers it holds: those it had received before this
+    // exposure get no frame of their own. Received is acknowledged before the exposure, or, still
+    // unacknowledged here, sent more than half a round trip before it.
+    while (true) {
+      skipFailed();
+      if (consumed == issued)
+        break;
+      const std::size_t at = consumed % kIssuedRing;
+      const std::int64_t acked = issued_acked_ns_[at].load(std::memory_order_acquire);
+      const std::int64_t sent = issued_sent_ns_[at].load(std::memory_order_relaxed);
+      const bool received_before = acked != kNotAcked && sent + (acked - sent) / 2 < *exposed_ns;
+      if (!received_before)
+        break;
+      ++consumed;
+      merged_.fetch_add(1, std::memory_order_relaxed);
+      lost_.fetch_add(1, std::memory_order_relaxed);
+    }
   }
   consumed_.store(consumed, std::memory_order_release);
   return matched;
@@ -454,6 +506,14 @@ void AravisCamera::deliver(const void* data, std::size_t size, int arv_status,
   // trusted; a damaged one is taken to be the next frame, and the next whole frame's id settles
   // any frames lost around it.
   const bool whole = arv_status == ARV_BUFFER_STATUS_SUCCESS;
+  std::optional<std::int64_t> exposed_ns;
+  const auto stamp = static_cast<std::int64_t>(device_timestamp_ns);
+  const std::int64_t arrived_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(received.system.time_since_epoch())
+          .count();
+  if (whole && stamp > 0 && stamp <= arrived_ns + kStampAheadNs &&
+      stamp >= arrived_ns - kStampAgeNs)
+    exposed_ns = stamp;
   if (!whole)
     frame_id = have_frame_id_ ? last_frame_id_ % kBlockIdWrap + 1 : frame_id;
   const std::uint64_t gap = have_frame_id_ ? frameIdGap(last_frame_id_, frame_id) : 1;
@@ -463,7 +523,7 @@ void AravisCamera::deliver(const void* data, std::size_t size, int arv_status,
   core::Frame frame;
   core::FrameMetadata& m = frame.metadata;
   if (config_.trigger == TriggerSource::kSoftware) {
-    if (!matchTrigger(gap, m.trigger_id)) {
+    if (!matchTrigger(gap, exposed_ns, m.trigger_id)) {
       unsolicited_.fetch_add(1, std::memory_order_relaxed);
       return;
     }
@@ -540,14 +600,17 @@ AravisStats AravisCamera::stats() const {
   s.status_missing_packets = missing_packets_.load();
   s.status_size_mismatch = size_mismatch_.load();
   s.status_other = other_status_.load();
+  s.triggers_paced = paced_.load();
+  s.triggers_merged = merged_.load();
+  s.frames_matched_by_time = matched_by_time_.load();
+  s.min_trigger_interval_us = min_trigger_interval_.count();
+  s.shortest_trigger_gap_us = shortest_gap_us_.load();
+  std::lock_guard lock(stream_mutex_);
   s.stream_completed = stream_completed_;
   s.stream_failures = stream_failures_;
   s.stream_underruns = stream_underruns_;
   s.packets_resent = packets_resent_;
   s.packets_missing = packets_missing_;
-  s.triggers_paced = paced_.load();
-  s.min_trigger_interval_us = min_trigger_interval_.count();
-  s.shortest_trigger_gap_us = shortest_gap_us_.load();
   if (vendor_->stream != nullptr) {
     guint64 completed = 0, failures = 0, underruns = 0, resent = 0, missing = 0;
     arv_stream_get_statistics(vendor_->stream, &completed, &failures, &underruns);
@@ -561,6 +624,16 @@ AravisStats AravisCamera::stats() const {
     }
   }
   return s;
+}
+
+CameraLinkStats AravisCamera::linkStats() const {
+  const AravisStats s = stats();
+  CameraLinkStats link;
+  link.has_packets = gv_device_.load();
+  link.packets_resent = s.packets_resent;
+  link.packets_missing = s.packets_missing;
+  link.frames_missing_packets = s.status_missing_packets;
+  return link;
 }
 
 }  // namespace fieldrig::drivers

@@ -58,6 +58,21 @@ struct AcquisitionStats {
   std::string alarm;
 };
 
+// The cameras' links (drivers::CameraLinkStats) summed over the rig and per camera, for
+// `fieldrig acquire`'s summary and the daemon's status. The packet totals count only the cameras
+// whose transport has packets; with none (sim, dc1394) they are not known: has_packets false.
+struct LinkSummary {
+  struct Camera {
+    std::string name;  // the layout's camera name
+    drivers::CameraLinkStats link;
+  };
+  bool has_packets = false;
+  std::uint64_t packets_resent = 0;
+  std::uint64_t packets_missing = 0;
+  std::uint64_t frames_missing_packets = 0;
+  std::vector<Camera> cameras;  // rig order
+};
+
 class Acquisition {
  public:
   using ProcessSet = std::function<void(const core::FrameSet& set)>;
@@ -84,6 +99,8 @@ class Acquisition {
   void interruptWaits();
 
   AcquisitionStats stats() const;
+  // Any thread; allocates (for summaries and the status, not for the trigger path).
+  LinkSummary linkSummary() const;
   std::uint64_t triggered() const { return triggered_.load(); }
   // Triggered sets that have not yet left the pipeline: not recorded (or lost) or, when live
   // processing runs, not processed or skipped. Virtual-time replay paces itself on this.

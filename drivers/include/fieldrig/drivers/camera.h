@@ -34,6 +34,18 @@ struct CameraConfig {
   std::map<std::string, std::string> options;  // driver-specific extras
 };
 
+// The link between one camera and the host as its driver counts it, for run summaries and the
+// daemon's status: generic, so that neither knows a driver. A snapshot.
+struct CameraLinkStats {
+  // The transport carries a frame in packets that the host can ask to have resent (GigE Vision).
+  // False for the others (1394 isochronous DMA, sim): the packet counts are then not known, and
+  // are reported as absent rather than as a clean link.
+  bool has_packets = false;
+  std::uint64_t packets_resent = 0;   // came back after a resend request
+  std::uint64_t packets_missing = 0;  // never came, resends included: their frames are damaged
+  std::uint64_t frames_missing_packets = 0;  // delivered marked corrupt for missing packets
+};
+
 class Camera {
  public:
   using FrameSink = std::function<void(core::Frame&& frame)>;
@@ -53,6 +65,9 @@ class Camera {
     (void)issued;
     return trigger(trigger_id);
   }
+  // The link's counters so far (after stop(): of the whole run). Any thread, at any time, also
+  // during start() and stop(); never blocks the frame path. Drivers without packets keep this.
+  virtual CameraLinkStats linkStats() const { return {}; }
 };
 
 class CameraRegistry {

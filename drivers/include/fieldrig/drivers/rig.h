@@ -75,6 +75,9 @@ class Rig {
   bool trigger(std::uint64_t trigger_id);
 
   RigStats stats() const;  // a snapshot; thread-safe
+  // Each camera's link counters, in rig order (Camera::linkStats); thread-safe. Allocates: for
+  // summaries and the status, never the trigger path.
+  std::vector<CameraLinkStats> cameraLinkStats() const;
   std::size_t cameraCount() const { return cameras_.size(); }
   core::FramePool& pool() { return *pool_; }
   const core::FramePool& pool() const { return *pool_; }

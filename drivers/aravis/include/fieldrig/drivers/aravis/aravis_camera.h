@@ -20,28 +20,43 @@
 //                         AcquisitionFrameRate, 0 when it has none; 0 turns pacing off)
 //
 // Triggers and frames: trigger() only queues the id (lock-free) and wakes the driver's trigger
-// thread, which issues the software trigger (a GVCP register write, a network round trip). Frames
-// are matched to issued triggers in order; the camera's frame id tells how many frames it sent
-// that never arrived, and those triggers are counted lost rather than shifting the ids of later
-// frames. Frames that arrive with no trigger outstanding (a free-running camera) are returned to
-// the stream uncounted as frames and counted as unsolicited. With an external trigger, trigger()
-// refuses (false) and frames are numbered 1, 2, … in arrival order, gaps included.
+// thread, which issues the software trigger (a GVCP register write, a network round trip) and
+// notes, on the host's real-time clock, when it sent the command and when the camera
+// acknowledged it. The camera's frame id tells how many frames it sent that never arrived, and
+// those triggers are counted lost rather than shifting the ids of later frames. A whole frame
+// whose device timestamp is on the host's clock (a camera synchronised by PTP, as the host is;
+// arv-fake-gv-camera stamps with the host's clock) is matched by time: it answers the oldest
+// outstanding trigger sent before its exposure, and the later ones the camera had already
+// received by then (acknowledged, or sent more than half their round trip, before the exposure)
+// were merged into it by the camera and are counted lost (triggers_merged); a frame exposed
+// before every outstanding trigger was sent answers none and is counted unsolicited. So a merge
+// costs its own trigger's frame, never the trigger ids of the frames after it. Other frames
+// (another clock, damaged frames whose stamp may be stale) are matched in order. Frames that arrive
+// with no trigger outstanding (a free-running camera) are returned to the stream uncounted as
+// frames and counted as unsolicited. With an external trigger, trigger() refuses (false) and frames
+// are numbered 1, 2, … in arrival order, gaps included.
 //
 // Pacing: a camera takes at most one trigger per frame period; a second command inside the same
 // period is merged into the first (arv-fake-gv-camera serves one per 40 ms) and the frame it never
-// sends carries no frame-id gap, so every later frame would be matched to the trigger before its
-// own. Scheduling delays on a busy host bunch triggers that were sent evenly, so the trigger
-// worker holds a command back until min_trigger_interval_us has passed since the previous one was
+// sends carries no frame-id gap: matched by time the merged trigger is counted lost, matched in
+// order every later frame would take the trigger before its own; either way it has no frame.
+// Scheduling delays on a busy host bunch triggers that were sent evenly, so the trigger worker
+// holds a command back until min_trigger_interval_us has passed since the previous one was
 // acknowledged; trigger() itself still never waits.
 //
-// Thread contract: configure/start/stop/stats on the owner thread; trigger() on one thread (the
-// trigger thread), never blocks. The FrameSink runs on Aravis' stream thread.
+// Thread contract: configure/start/stop on the owner thread; trigger() on one thread (the
+// trigger thread), never blocks; stats() and linkStats() from any thread (a mutex the frame path
+// never takes keeps the stream alive while they read it). The FrameSink runs on Aravis' stream
+// thread.
 #pragma once
 
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <thread>
 
 #include "fieldrig/core/spsc_queue.h"
@@ -58,8 +73,11 @@ struct AravisStats {
   std::uint64_t frames_corrupt = 0;     // delivered with status kCorrupt (sum of the reasons below)
   std::uint64_t frames_dropped = 0;     // delivered as kDropped: the frame pool was empty
   std::uint64_t frames_lost = 0;        // triggered, never delivered (frame-id gap, or stop)
-  std::uint64_t frames_unsolicited = 0;      // arrived with no trigger outstanding; not delivered
-  std::uint64_t triggers_paced = 0;          // commands held back to keep the minimum interval
+  std::uint64_t frames_unsolicited = 0;  // arrived with no trigger outstanding; not delivered
+  std::uint64_t triggers_paced = 0;      // commands held back to keep the minimum interval
+  // Triggers the camera merged into an earlier trigger's exposure (also in frames_lost).
+  std::uint64_t triggers_merged = 0;
+  std::uint64_t frames_matched_by_time = 0;  // by device timestamp; the others by frame order
   std::int64_t min_trigger_interval_us = 0;  // the pacing in force (configure's result)
   // The shortest time from one command's acknowledgement to the next command, -1 before two.
   std::int64_t shortest_trigger_gap_us = -1;
@@ -92,6 +110,9 @@ class AravisCamera final : public Camera {
   bool trigger(std::uint64_t trigger_id) override;
 
   AravisStats stats() const;
+  // packets_resent and packets_missing of a GigE Vision stream, and the frames marked for missing
+  // packets; has_packets is false for a USB3 Vision or in-process fake camera.
+  CameraLinkStats linkStats() const override;
 
  private:
   struct Vendor;  // the Aravis objects; defined where arv.h is included
@@ -103,7 +124,10 @@ class AravisCamera final : public Camera {
                std::uint64_t device_timestamp_ns);
   // Stream thread: the trigger id for the next frame, after `gap` - 1 frames that never came;
   // false when none is outstanding.
-  bool matchTrigger(std::uint64_t gap, std::uint64_t& trigger_id);
+  // `exposed_ns`: the frame's device timestamp on the host's real-time clock, or nullopt when it
+  // is not (then frames are matched in order).
+  bool matchTrigger(std::uint64_t gap, std::optional<std::int64_t> exposed_ns,
+                    std::uint64_t& trigger_id);
   std::uint64_t outstandingTriggers() const;  // owner thread, after the stream has stopped
   friend struct AravisCallbacks;
 
@@ -128,7 +152,11 @@ class AravisCamera final : public Camera {
   std::atomic<bool> running_{false};
   std::thread trigger_worker_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> issued_ids_;  // kIssuedRing slots
-  std::atomic<std::uint64_t> issued_{0};                      // slots written (trigger worker)
+  // Per slot, host real-time clock (ns): the command sent, and acknowledged (kNotAcked until then).
+  std::unique_ptr<std::atomic<std::int64_t>[]> issued_sent_ns_;
+  std::unique_ptr<std::atomic<std::int64_t>[]> issued_acked_ns_;
+  static constexpr std::int64_t kNotAcked = std::numeric_limits<std::int64_t>::max();
+  std::atomic<std::uint64_t> issued_{0};    // slots written (trigger worker)
   std::atomic<std::uint64_t> consumed_{0};  // slots matched or counted lost (stream thread)
 
   // Trigger worker only: when the previous command was acknowledged.
@@ -142,10 +170,14 @@ class AravisCamera final : public Camera {
   // Counters, each written by one thread, read by stats().
   std::atomic<std::uint64_t> accepted_{0}, refused_{0}, failed_{0}, delivered_{0}, corrupt_{0},
       dropped_{0}, lost_{0}, unsolicited_{0}, timeout_{0}, missing_packets_{0}, size_mismatch_{0},
-      other_status_{0}, paced_{0};
+      other_status_{0}, paced_{0}, merged_{0}, matched_by_time_{0};
   std::atomic<std::int64_t> shortest_gap_us_{-1};  // trigger worker
-  std::uint64_t stream_completed_ = 0, stream_failures_ = 0, stream_underruns_ = 0,  // owner
-      packets_resent_ = 0, packets_missing_ = 0;
+  std::atomic<bool> gv_device_{false};             // configure's camera speaks GigE Vision
+  // Guards vendor_->stream's lifetime (start creates it, stop releases it) against readers on
+  // other threads, and the totals the owner keeps from the last stop().
+  mutable std::mutex stream_mutex_;
+  std::uint64_t stream_completed_ = 0, stream_failures_ = 0, stream_underruns_ = 0,
+                packets_resent_ = 0, packets_missing_ = 0;
 };
 
 }  // namespace fieldrig::drivers
