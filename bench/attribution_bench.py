@@ -37,6 +37,8 @@ import subprocess
 import sys
 import tempfile
 
+from mesh_field_bench import add_field_arguments, read_truth, rendered_field
+
 TRAITS = [("height_m", "height", "m"), ("width_m", "width", "m"), ("vvi", "VVI", ""),
           ("vai", "VAI", "")]
 
@@ -74,25 +76,12 @@ def process(fieldrig, field, out, extra, process_args):
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("build", nargs="?", default="build")
-    parser.add_argument("--plots", type=int, default=8)
-    parser.add_argument("--rows", type=int, default=2)
-    parser.add_argument("--seed", type=int, default=11)
-    parser.add_argument("--out")
-    parser.add_argument("--process-args", default="")
+    add_field_arguments(parser, plots=8)
     args = parser.parse_args()
     fieldrig = os.path.join(args.build, "tools", "fieldrig")
     work = args.out or tempfile.mkdtemp(prefix="attribution_bench_")
-    field = os.path.join(work, "field")
-    if not os.path.exists(os.path.join(field, "truth.jsonl")):
-        subprocess.run([fieldrig, "simulate", "--plots", str(args.plots), "--rows", str(args.rows),
-                        "--seed", str(args.seed), "--stage", "early,mid,mature", "--out", field],
-                       check=True, stdout=subprocess.DEVNULL)
-    truth = {}
-    with open(os.path.join(field, "truth.jsonl")) as f:
-        for line in f:
-            j = json.loads(line)
-            truth[j["plot"]] = j
+    field = rendered_field(fieldrig, args, work)
+    truth = read_truth(field)
     from_truth = process(fieldrig, field, os.path.join(work, "results-truth-depth"),
                          ["--depth-source", "truth"], args.process_args)
     from_truth_no_edges = None

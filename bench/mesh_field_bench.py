@@ -57,31 +57,48 @@ def table(rows, title):
     return out
 
 
-def main():
-    parser = argparse.ArgumentParser()
+def add_field_arguments(parser, plots):
+    """The options every bench on the rendered field takes (also attribution_bench.py)."""
     parser.add_argument("build", nargs="?", default="build")
-    parser.add_argument("--plots", type=int, default=24)
+    parser.add_argument("--plots", type=int, default=plots)
     parser.add_argument("--rows", type=int, default=2)
     parser.add_argument("--seed", type=int, default=11)
     parser.add_argument("--out")
     parser.add_argument("--process-args", default="")
-    args = parser.parse_args()
-    fieldrig = os.path.join(args.build, "tools", "fieldrig")
-    work = args.out or tempfile.mkdtemp(prefix="mesh_field_bench_")
+
+
+def rendered_field(fieldrig, args, work):
+    """WORK/field, rendered by `fieldrig simulate` unless a field is already there."""
     field = os.path.join(work, "field")
-    results = os.path.join(work, "results")
     if not os.path.exists(os.path.join(field, "truth.jsonl")):
         subprocess.run([fieldrig, "simulate", "--plots", str(args.plots), "--rows", str(args.rows),
                         "--seed", str(args.seed), "--stage", "early,mid,mature", "--out", field],
                        check=True, stdout=subprocess.DEVNULL)
-    subprocess.run([fieldrig, "process", os.path.join(field, "source-session"), "--map",
-                    os.path.join(field, "map.csv"), "--out", results, "--force"] +
-                   shlex.split(args.process_args), check=True, stdout=subprocess.DEVNULL)
+    return field
+
+
+def read_truth(field):
+    """The field's per-plot truth lines by plot id."""
     truth = {}
     with open(os.path.join(field, "truth.jsonl")) as f:
         for line in f:
             j = json.loads(line)
             truth[j["plot"]] = j
+    return truth
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    add_field_arguments(parser, plots=24)
+    args = parser.parse_args()
+    fieldrig = os.path.join(args.build, "tools", "fieldrig")
+    work = args.out or tempfile.mkdtemp(prefix="mesh_field_bench_")
+    field = rendered_field(fieldrig, args, work)
+    results = os.path.join(work, "results")
+    subprocess.run([fieldrig, "process", os.path.join(field, "source-session"), "--map",
+                    os.path.join(field, "map.csv"), "--out", results, "--force"] +
+                   shlex.split(args.process_args), check=True, stdout=subprocess.DEVNULL)
+    truth = read_truth(field)
     rows = []
     with open(os.path.join(results, "plots.jsonl")) as f:
         for line in f:
