@@ -107,6 +107,7 @@ main() {
                pipeline/stem/src/quadrangle.cpp pipeline/stem/src/stem_measurer.cpp
                pipeline/stem/src/measurement_json.cpp pipeline/stem/src/measurement_log.cpp
                pipeline/stereo/src/calibration.cpp pipeline/stereo/src/preprocess.cpp
+               pipeline/stereo/src/disparity_io.cpp
                pipeline/stereo/src/rectifier.cpp pipeline/cloud/src/rig_calibration.cpp
                recording/src/session_format.cpp recording/src/session_writer.cpp
                recording/src/session_reader.cpp recording/src/file_util.cpp
