@@ -345,7 +345,7 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     alignas(64) RTCRayHit16 packet;
-    std::array<int, kPacket> valid{};
+    alignas(64) std::array<int, kPacket> valid{};  // rtcIntersect16 reads it aligned
     std::array<Eigen::Vector3f, kPacket> dirs;
     std::array<int, kPacket> index{};
     for (int ty = range.start; ty < range.end; ++ty) {
@@ -382,7 +382,7 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
     shadow_context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // parallel rays from one tile
     alignas(64) RTCRayHit16 packet;
     alignas(64) RTCRay16 shadow;
-    std::array<int, kPacket> valid{};
+    alignas(64) std::array<int, kPacket> valid{};  // rtcIntersect16 reads it aligned
     std::array<Eigen::Vector3f, kPacket> dirs;
     std::vector<Hit> sample_hits(4 * kPacket);
     std::vector<ShadePoint> points;
@@ -603,7 +603,7 @@ std::vector<std::uint8_t> visibleFromAny(const MeshRenderScene& render_scene,
   cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
     const FlushDenormals flush;
     alignas(64) RTCRay16 rays;
-    std::array<int, kPacket> valid{};
+    alignas(64) std::array<int, kPacket> valid{};  // rtcIntersect16 reads it aligned
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     for (int block = range.start; block < range.end; ++block) {
