@@ -71,6 +71,9 @@ std::int64_t realtimeNs() {
 // exposure, transfer and a stalled host).
 constexpr std::int64_t kStampAheadNs = 20'000'000;
 constexpr std::int64_t kStampAgeNs = 10'000'000'000;
+// Added to the longest answer seen (plus a quarter) before an undecided trigger is taken to have
+// been merged: scheduling jitter of the host that stamps the commands.
+constexpr std::int64_t kLatencySlackNs = 5'000'000;
 
 // Enables the in-process fake interface once: Aravis keeps it enabled for the process.
 void enableFakeInterface() {
@@ -298,6 +301,8 @@ core::Result<void> AravisCamera::start(core::FramePool& pool, FrameSink sink) {
   last_trigger_acked_ = {};
   shortest_gap_us_ = -1;
   have_frame_id_ = false;
+  last_exposed_ns_.reset();
+  answer_latency_ns_ = -1;
   external_count_ = 0;
 
   {
@@ -457,33 +462,50 @@ bool AravisCamera::matchTrigger(std::uint64_t gap, std::optional<std::int64_t> e
   }
   skipFailed();
   bool matched = false;
-  if (consumed < issued && !exposed_ns) {
-    trigger_id = issued_ids_[consumed % kIssuedRing].load(std::memory_order_relaxed);
+  if (!exposed_ns) {
+    if (consumed < issued) {
+      trigger_id = issued_ids_[consumed % kIssuedRing].load(std::memory_order_relaxed);
+      ++consumed;
+      matched = true;
+    }
+    last_exposed_ns_.reset();  // an exposure of unknown time: nothing to settle against it
+    consumed_.store(consumed, std::memory_order_release);
+    return matched;
+  }
+  const std::int64_t exposed = *exposed_ns;
+  auto sentAt = [&](std::uint64_t slot) {
+    return issued_sent_ns_[slot % kIssuedRing].load(std::memory_order_relaxed);
+  };
+  auto countMerged = [&] {
     ++consumed;
-    matched = true;
-  } else if (consumed < issued && issued_sent_ns_[consumed % kIssuedRing].load(
-                                      std::memory_order_relaxed) <= *exposed_ns) {
+    merged_.fetch_add(1, std::memory_order_relaxed);
+    lost_.fetch_add(1, std::memory_order_relaxed);
+    skipFailed();
+  };
+  // Triggers left undecided at the last exposure (sent before it, acknowledged after it): one
+  // this frame could not answer, because it came later than any trigger's answer has taken, was
+  // received before that exposure and merged into it.
+  while (consumed < issued && last_exposed_ns_ && sentAt(consumed) <= *last_exposed_ns_ &&
+         answer_latency_ns_ >= 0 &&
+         exposed - sentAt(consumed) > answer_latency_ns_ + answer_latency_ns_ / 4 + kLatencySlackNs)
+    countMerged();
+  if (consumed < issued && sentAt(consumed) <= exposed) {
+    const std::int64_t sent = sentAt(consumed);
     trigger_id = issued_ids_[consumed % kIssuedRing].load(std::memory_order_relaxed);
     ++consumed;
     matched = true;
     matched_by_time_.fetch_add(1, std::memory_order_relaxed);
-    // The camera exposes once for all the triggers it holds: those it had received before this
-    // exposure get no frame of their own. Received is acknowledged before the exposure, or, still
-    // unacknowledged here, sent more than half a round trip before it.
-    while (true) {
-      skipFailed();
-      if (consumed == issued)
-        break;
-      const std::size_t at = consumed % kIssuedRing;
-      const std::int64_t acked = issued_acked_ns_[at].load(std::memory_order_acquire);
-      const std::int64_t sent = issued_sent_ns_[at].load(std::memory_order_relaxed);
-      const bool received_before = acked != kNotAcked && sent + (acked - sent) / 2 < *exposed_ns;
-      if (!received_before)
-        break;
-      ++consumed;
-      merged_.fetch_add(1, std::memory_order_relaxed);
-      lost_.fetch_add(1, std::memory_order_relaxed);
-    }
+    // Sent after the last exposure, this trigger can only be this frame's: how long the camera
+    // took to answer it bounds the settling above.
+    if (!last_exposed_ns_ || sent > *last_exposed_ns_)
+      answer_latency_ns_ = std::max(answer_latency_ns_, exposed - sent);
+    // The camera exposes once for all the triggers it holds: those it acknowledged before this
+    // exposure get no frame of their own.
+    skipFailed();
+    while (consumed < issued &&
+           issued_acked_ns_[consumed % kIssuedRing].load(std::memory_order_acquire) < exposed)
+      countMerged();
+    last_exposed_ns_ = exposed;
   }
   consumed_.store(consumed, std::memory_order_release);
   return matched;

@@ -27,9 +27,13 @@
 // whose device timestamp is on the host's clock (a camera synchronised by PTP, as the host is;
 // arv-fake-gv-camera stamps with the host's clock) is matched by time: it answers the oldest
 // outstanding trigger sent before its exposure, and the later ones the camera had already
-// received by then (acknowledged, or sent more than half their round trip, before the exposure)
-// were merged into it by the camera and are counted lost (triggers_merged); a frame exposed
-// before every outstanding trigger was sent answers none and is counted unsolicited. So a merge
+// received by then (acknowledged before the exposure) were merged into it by the camera and are
+// counted lost (triggers_merged). A trigger sent before the exposure but acknowledged after it
+// may have come just before or just after: it stays outstanding, and the next frame settles it:
+// if that frame came later than the camera has ever taken to answer a trigger, the trigger was
+// merged; otherwise it is that frame's trigger (the host's stamps bracket the camera's receipt;
+// guessing inside that bracket failed when a slow host widened it). A frame exposed before every
+// outstanding trigger was sent answers none and is counted unsolicited. So a merge
 // costs its own trigger's frame, never the trigger ids of the frames after it. Other frames
 // (another clock, damaged frames whose stamp may be stale) are matched in order. Frames that arrive
 // with no trigger outstanding (a free-running camera) are returned to the stream uncounted as
@@ -166,6 +170,10 @@ class AravisCamera final : public Camera {
   bool have_frame_id_ = false;
   std::uint64_t last_frame_id_ = 0;
   std::uint64_t external_count_ = 0;
+  // The exposure of the last frame matched by time (nullopt after one matched in order), and the
+  // longest a trigger sent after the previous exposure took to be exposed (-1 before any).
+  std::optional<std::int64_t> last_exposed_ns_;
+  std::int64_t answer_latency_ns_ = -1;
 
   // Counters, each written by one thread, read by stats().
   std::atomic<std::uint64_t> accepted_{0}, refused_{0}, failed_{0}, delivered_{0}, corrupt_{0},
