@@ -23,19 +23,29 @@ Result<std::unique_ptr<FramePool>> FramePool::create(std::size_t buffer_count,
     return Error{fmt::format("frame pool: {} buffers of {} bytes overflow the addressable size",
                              buffer_count, buffer_bytes)};
   }
-  // Allocation is the one failure left, and a pool is sized from configuration: report it.
-  try {
-    return std::unique_ptr<FramePool>(new FramePool(buffer_count, buffer_bytes));
-  } catch (const std::bad_alloc&) {
+  // Allocation is the one failure left, and a pool is sized from configuration: report it. The
+  // buffers are asked for without throwing: AddressSanitizer (scripts/test-sanitize.sh) aborts on
+  // a throwing new it cannot satisfy, but lets a non-throwing one return null as glibc does.
+  const auto fail = [&] {
     return Error{fmt::format("frame pool: cannot allocate {} buffers of {} bytes ({} bytes in all)",
                              buffer_count, buffer_bytes, buffer_count * buffer_bytes)};
+  };
+  std::unique_ptr<std::uint8_t[]> memory(new (std::nothrow)
+                                             std::uint8_t[buffer_count * buffer_bytes]());
+  if (!memory)
+    return fail();
+  try {
+    return std::unique_ptr<FramePool>(new FramePool(buffer_count, buffer_bytes, std::move(memory)));
+  } catch (const std::bad_alloc&) {
+    return fail();
   }
 }
 
-FramePool::FramePool(std::size_t buffer_count, std::size_t buffer_bytes)
+FramePool::FramePool(std::size_t buffer_count, std::size_t buffer_bytes,
+                     std::unique_ptr<std::uint8_t[]> memory)
     : buffer_count_(buffer_count),
       buffer_bytes_(buffer_bytes),
-      memory_(std::make_unique<std::uint8_t[]>(buffer_count * buffer_bytes)),
+      memory_(std::move(memory)),
       references_(std::make_unique<std::atomic<int>[]>(buffer_count)),
       free_(buffer_count),
       available_(buffer_count) {

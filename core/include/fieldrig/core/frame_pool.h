@@ -71,7 +71,8 @@ class FramePool {
 
  private:
   friend class FrameBuffer;
-  FramePool(std::size_t buffer_count, std::size_t buffer_bytes);
+  FramePool(std::size_t buffer_count, std::size_t buffer_bytes,
+            std::unique_ptr<std::uint8_t[]> memory);
   void addReference(std::uint32_t index) noexcept;
   void dropReference(std::uint32_t index) noexcept;
   std::uint8_t* data(std::uint32_t index) const { return memory_.get() + index * buffer_bytes_; }
