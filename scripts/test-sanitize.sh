@@ -12,8 +12,9 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${FIELDRIG_BUILD_DIR:-$root/build-asan}
 FIELDRIG_SANITIZE=address,undefined FIELDRIG_BUILD_DIR="$build" "$root/scripts/build.sh"
 # Stack traces for UB reports; leak detection; and an allocation too large for ASan's allocator
-# returns null (std::bad_alloc) as it does without ASan, since the frame pool's tests check that
-# such a request is refused with an error rather than aborting.
+# returns null from malloc and a non-throwing new, as glibc does (ASan still aborts a throwing
+# new it cannot satisfy), since the frame pool's tests check that such a request is refused with
+# an error rather than aborting.
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}"
 # Instrumented code runs 2-3 times slower: the per-test limit is three times the README build's.
