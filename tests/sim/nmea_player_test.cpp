@@ -126,7 +126,7 @@ TEST(NmeaPlayerTest, NotInRealTimeTheFileComesAsFastAsItIsRead) {
   const ScopedTempDir dir("nmea_player_fast");
   std::string text;
   for (int second = 0; second < 60; ++second) {  // a minute of capture
-    char time[24];  // room for any int, so no -O1 truncation warning
+    char time[24];  // room for any int: no format-truncation warning at any level
     std::snprintf(time, sizeof time, "1530%02d.00", second);
     text += rmc(time) + "\r\n" + gga(time) + "\r\n";
   }
