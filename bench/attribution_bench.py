@@ -7,6 +7,9 @@ Makes (or reuses) a synthetic field as bench/mesh_field_bench.py does (`fieldrig
 `fieldrig process` chain, differing only in where each head's depth comes from:
   (a) the truth: traits by their definitions on the plants' mesh surfaces that some camera sees
       (DIR/truth.jsonl; meshPlotTruth). Everything is measured against it, so it is the zero row;
+      "(a'') stereo view" what stereo cannot place (the truth's `stereo_view` block: the same
+      definitions on the samples both cameras of some head see; plant only one camera of a pair
+      sees is in (a) but not in it);
       "(a') full geometry" shows what the view itself hides (the truth's `full` block: the same
       definitions on all of the plot's surfaces, seen or not).
   (b) `--depth-source truth`: each head's left camera's rendered truth depth map (beside every
@@ -123,6 +126,8 @@ def main():
     rows = [
         ("(a) mesh truth (seen surfaces)", {p: truth[p] for p in plots}),
         ("(a') full geometry, seen or not", {p: truth[p].get("full", {}) for p in plots}),
+        ("(a'') stereo view: seen by both cameras of a head",
+         {p: truth[p].get("stereo_view", {}) for p in plots}),
         ("(b) truth depth → fusion → traits", {p: from_truth.get(p, {}).get("traits", {})
                                                for p in plots}),
         ("(b') truth depth, no edge filter", {p: (from_truth_no_edges or {}).get(p, {})

@@ -443,6 +443,7 @@ TEST(MeshSession, TruthMapsBesideEachFrameAndTruthThatFitsTheMeshes) {
                             "view_top_m",
                             "exceeds_view",
                             "full",
+                            "stereo_view",
                             "plants",
                             "plot_codes",
                             "truth_maps"}) {
@@ -485,6 +486,14 @@ TEST(MeshSession, TruthMapsBesideEachFrameAndTruthThatFitsTheMeshes) {
   EXPECT_LE(line.at("visible_plant_area_m2").get<double>(),
             line.at("total_plant_area_m2").get<double>());
   EXPECT_GE(line.at("full").at("height_m").get<double>(), height - 0.02);
+  // What both cameras of a head see is a part of what some camera sees, and most of it.
+  const auto& stereo_view = line.at("stereo_view");
+  EXPECT_EQ(stereo_view.at("status"), "ok");
+  const double seen_area = line.at("visible_plant_area_m2").get<double>();
+  const double stereo_area = stereo_view.at("visible_plant_area_m2").get<double>();
+  EXPECT_LT(stereo_area, seen_area) << "every plot has plant only one camera of a pair sees";
+  EXPECT_GT(stereo_area, 0.5 * seen_area);
+  EXPECT_NEAR(stereo_view.at("height_m").get<double>(), height, 0.05);
   // Every plant of the plot, with stem diameters that shrink upwards and are stem-sized.
   const auto& plants = line.at("plants");
   EXPECT_EQ(plants.size(), 20U);  // 3 m at 0.15 m, none missing (the series' first plot)

@@ -109,6 +109,48 @@ TEST_F(EvaluateCli, TruthAsAJsonArrayOrPlotsObjectReadsAsTheLinesDo) {
               1e-9);
 }
 
+TEST_F(EvaluateCli, TruthViewScoresAgainstTheNamedBlockOfEachTruthLine) {
+  // The mesh truth's other definitions sit in their own object: the stereo view's widths here
+  // are 4 cm narrower than the seen view's, so A's width error becomes 0 and B's +6 cm.
+  auto meshLine = [](const std::string& plot, double height, double width, double vvi) {
+    Json line = Json::parse(truthLine(plot, height, width, vvi));
+    line["stereo_view"] = Json::parse(truthLine(plot, height, width - 0.04, vvi));
+    line["stereo_view"].erase("plot");
+    return line.dump();
+  };
+  writeLines(truth, {meshLine("A", 1.00, 0.50, 0.40), meshLine("B", 2.00, 0.80, 0.50),
+                     meshLine("C", 1.50, 0.60, 0.20)});
+  const auto seen = runFieldrig(
+      {"evaluate", results_dir.string(), "--truth", truth.string(), "--summary-only"}, dir.path());
+  ASSERT_EQ(seen.exit_code, 0) << seen.err;
+  EXPECT_NEAR(Json::parse(seen.out_lines.back())["summary"]["width_m"]["bias"].get<double>(), -0.01,
+              1e-9);
+  const auto stereo = runFieldrig({"evaluate", results_dir.string(), "--truth", truth.string(),
+                                   "--truth-view", "stereo", "--summary-only"},
+                                  dir.path());
+  ASSERT_EQ(stereo.exit_code, 0) << stereo.err;
+  const Json width = Json::parse(stereo.out_lines.back())["summary"]["width_m"];
+  EXPECT_NEAR(width["bias"].get<double>(), 0.03, 1e-9);
+  EXPECT_NEAR(width["max_abs"].get<double>(), 0.06, 1e-9);
+  EXPECT_EQ(width["worst_plot"], "B");
+
+  // A truth without that block (the fixture's plain lines, or a field simulated before the
+  // block existed) is refused with the line, not scored against the seen view.
+  writeLines(truth, {truthLine("A", 1.00, 0.50, 0.40)});
+  const auto old_truth = runFieldrig(
+      {"evaluate", results_dir.string(), "--truth", truth.string(), "--truth-view", "stereo"},
+      dir.path());
+  EXPECT_EQ(old_truth.exit_code, 2);
+  EXPECT_NE(old_truth.err.find("truth.jsonl:1: plot A: no \"stereo_view\" object"),
+            std::string::npos)
+      << old_truth.err;
+  EXPECT_TRUE(old_truth.out_lines.empty());
+  const auto unknown = runFieldrig(
+      {"evaluate", results_dir.string(), "--truth", truth.string(), "--truth-view", "left"},
+      dir.path());
+  EXPECT_EQ(unknown.exit_code, 2) << "an unknown view is a usage error";
+}
+
 TEST_F(EvaluateCli, BadFilesAreNamedWithTheLineAndField) {
   struct Case {
     std::string what;

@@ -11,6 +11,7 @@ namespace {
 struct EvaluateArgs {
   std::string results;
   std::string truth;
+  std::string truth_view = "seen";
   bool summary_only = false;
 };
 
@@ -19,7 +20,10 @@ int runEvaluate(const EvaluateArgs& args) {
   const auto results = sim::readPlotTraits(args.results);
   if (!results)
     return fail(kWho, results.error().message);
-  const auto truth = sim::readPlotTraits(args.truth);
+  const std::string block = args.truth_view == "stereo" ? "stereo_view"
+                            : args.truth_view == "full" ? "full"
+                                                        : "";
+  const auto truth = sim::readPlotTraits(args.truth, block);
   if (!truth)
     return fail(kWho, truth.error().message);
   const auto evaluation = sim::evaluateTraits(*results, *truth);
@@ -46,6 +50,12 @@ void registerEvaluateCommand(CLI::App& app, int& exit_code) {
       ->add_option("--truth", args->truth,
                    "The field's truth: truth.jsonl of `fieldrig simulate`, or a JSON file")
       ->required();
+  evaluate
+      ->add_option("--truth-view", args->truth_view,
+                   "Which plant surfaces a mesh truth's traits are taken on: seen (by some camera; "
+                   "the default), stereo (by both cameras of some head: what stereo can place) or "
+                   "full (all of the plot's plants in the imaged stretch of row, seen or not)")
+      ->check(CLI::IsMember({"seen", "stereo", "full"}));
   evaluate->add_flag("--summary-only", args->summary_only, "Print only the JSON summary line");
 }
 

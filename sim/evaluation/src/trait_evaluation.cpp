@@ -14,7 +14,8 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 // `where` ("truth.jsonl:3") + what is wrong with one plot object.
-core::Result<PlotTraitValues> plotFromJson(const Json& object, const std::string& where) {
+core::Result<PlotTraitValues> plotFromJson(const Json& object, const std::string& where,
+                                           const std::string& block) {
   if (!object.is_object())
     return core::Error{where + ": a plot must be a JSON object"};
   PlotTraitValues plot;
@@ -27,8 +28,12 @@ core::Result<PlotTraitValues> plotFromJson(const Json& object, const std::string
   }
   if (plot.plot.empty())
     return core::Error{where + ": no \"plot\" (or \"location\") id"};
-  // Results nest the traits under "traits"; truth lines hold them at the top.
-  const auto nested = object.find("traits");
+  // Results nest the traits under "traits"; truth lines hold them at the top, and other
+  // definitions of the truth in their own object.
+  const auto nested = object.find(block.empty() ? "traits" : block);
+  if (!block.empty() && (nested == object.end() || !nested->is_object()))
+    return core::Error{where + ": plot " + plot.plot + ": no \"" + block +
+                       "\" object (a truth written before it existed: simulate the field again)"};
   const Json& traits = nested != object.end() && nested->is_object() ? *nested : object;
   if (const auto status = traits.find("status"); status != traits.end() && status->is_string())
     plot.status = status->get<std::string>();
@@ -59,7 +64,8 @@ std::string cell(double value, int width, int decimals) {
 
 }  // namespace
 
-core::Result<std::vector<PlotTraitValues>> readPlotTraits(const fs::path& path) {
+core::Result<std::vector<PlotTraitValues>> readPlotTraits(const fs::path& path,
+                                                          const std::string& block) {
   std::error_code error;
   fs::path file = path;
   if (fs::is_directory(path, error)) {
@@ -75,7 +81,7 @@ core::Result<std::vector<PlotTraitValues>> readPlotTraits(const fs::path& path) 
   std::vector<PlotTraitValues> plots;
   std::set<std::string> seen;
   auto add = [&](const Json& object, const std::string& where) -> core::Result<void> {
-    core::Result<PlotTraitValues> plot = plotFromJson(object, where);
+    core::Result<PlotTraitValues> plot = plotFromJson(object, where, block);
     if (!plot)
       return plot.error();
     if (!seen.insert(plot->plot).second)

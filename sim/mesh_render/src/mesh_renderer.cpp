@@ -594,9 +594,10 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
   return frame;
 }
 
-std::vector<std::uint8_t> visibleFromAny(const MeshRenderScene& render_scene,
-                                         const std::vector<MeshCamera>& cameras,
-                                         const std::vector<Eigen::Vector3f>& points) {
+std::vector<std::uint8_t> camerasSeeing(const MeshRenderScene& render_scene,
+                                        const std::vector<MeshCamera>& cameras,
+                                        const std::vector<Eigen::Vector3f>& points) {
+  CV_Assert(cameras.size() <= 8);  // one bit each in a byte
   std::vector<std::uint8_t> visible(points.size(), 0);
   auto* scene = static_cast<RTCScene>(render_scene.handle());
   const int blocks = static_cast<int>((points.size() + kPacket - 1) / kPacket);
@@ -608,11 +609,12 @@ std::vector<std::uint8_t> visibleFromAny(const MeshRenderScene& render_scene,
     rtcInitIntersectContext(&context);
     for (int block = range.start; block < range.end; ++block) {
       const std::size_t first = static_cast<std::size_t>(block) * kPacket;
-      for (const MeshCamera& camera : cameras) {
+      for (std::size_t c = 0; c < cameras.size(); ++c) {
+        const MeshCamera& camera = cameras[c];
         bool any = false;
         for (int lane = 0; lane < kPacket; ++lane) {
           const std::size_t i = first + static_cast<std::size_t>(lane);
-          bool use = i < points.size() && visible[i] == 0;
+          bool use = i < points.size();
           Eigen::Vector3d d = Eigen::Vector3d::UnitZ();
           if (use) {
             const Eigen::Vector3d p = points[i].cast<double>();
@@ -642,7 +644,7 @@ std::vector<std::uint8_t> visibleFromAny(const MeshRenderScene& render_scene,
         for (int lane = 0; lane < kPacket; ++lane) {
           const std::size_t i = first + static_cast<std::size_t>(lane);
           if (valid[static_cast<std::size_t>(lane)] != 0 && rays.tfar[lane] >= 0.0F)
-            visible[i] = 1;
+            visible[i] = static_cast<std::uint8_t>(visible[i] | (1U << c));
         }
       }
     }

@@ -104,18 +104,32 @@ MeshPlotTruth meshPlotTruth(const MeshRenderScene& render_scene,
   positions.reserve(samples.size());
   for (const PlotSample& s : samples)
     positions.push_back(s.position);
-  const std::vector<std::uint8_t> seen = visibleFromAny(render_scene, cameras, positions);
+  const std::vector<std::uint8_t> seen_by = camerasSeeing(render_scene, cameras, positions);
   float y_lo = std::numeric_limits<float>::infinity();
   float y_hi = -std::numeric_limits<float>::infinity();
+  // Stereo can only place a point both cameras of one head see; the cameras come in heads'
+  // (left, right) pairs.
+  std::uint8_t head_pairs_mask = 0;
+  for (std::size_t c = 0; c + 1 < cameras.size(); c += 2)
+    head_pairs_mask = static_cast<std::uint8_t>(head_pairs_mask | (1U << c));
+  PlotCloud stereo_view;
+  stereo_view.truth = plot;
   for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (!seen[i])
+    if (seen_by[i] == 0)
       continue;
     plot.visible_plant_samples.push_back(samples[i]);
     plot.visible_plant_area_m2 += samples[i].area_m2;
     y_lo = std::min(y_lo, samples[i].position.y());
     y_hi = std::max(y_hi, samples[i].position.y());
+    const auto both = static_cast<std::uint8_t>(seen_by[i] & (seen_by[i] >> 1) & head_pairs_mask);
+    if (both != 0) {
+      stereo_view.truth.visible_plant_samples.push_back(samples[i]);
+      stereo_view.truth.visible_plant_area_m2 += samples[i].area_m2;
+    }
   }
   truth.traits = plotTruth(truth.visible, options.traits);
+  truth.stereo_view = plotTruth(stereo_view, options.traits);
+  truth.stereo_view_plant_area_m2 = stereo_view.truth.visible_plant_area_m2;
 
   PlotCloud full;
   full.truth = plot;
@@ -163,6 +177,15 @@ nlohmann::ordered_json meshTruthJson(const MeshPlotTruth& truth, const MeshScene
                {"vai", truth.full.vai},
                {"z_min_m", f.z_min},
                {"z_max_m", f.z_max}};
+  const traits::TraitsResult& stereo = truth.stereo_view.definitions;
+  j["stereo_view"] = {{"status", traits::statusName(stereo.status)},
+                      {"height_m", stereo.height_m},
+                      {"width_m", stereo.width_m},
+                      {"vvi", stereo.vvi},
+                      {"vai", truth.stereo_view.vai},
+                      {"z_min_m", stereo.z_min},
+                      {"z_max_m", stereo.z_max},
+                      {"visible_plant_area_m2", truth.stereo_view_plant_area_m2}};
   j["samples"] = truth.samples;
   j["visible_samples"] = truth.visible.truth.visible_plant_samples.size();
   Json plants = Json::array();

@@ -60,8 +60,11 @@ struct TraitEvaluation {
 };
 
 // Reads one side. `path` is a results folder (its plots.jsonl), a JSON-lines file or a JSON file
-// (an array, or an object with "plots"). Errors name the file, the line and the field.
-core::Result<std::vector<PlotTraitValues>> readPlotTraits(const std::filesystem::path& path);
+// (an array, or an object with "plots"). With `block` ("stereo_view", "full": a mesh truth's
+// other definitions of what counts) each plot's traits come from that object of the line, and a
+// line without it is an error. Errors name the file, the line and the field.
+core::Result<std::vector<PlotTraitValues>> readPlotTraits(const std::filesystem::path& path,
+                                                          const std::string& block = {});
 
 // Compares `results` with `truth`. An error when they share no plot id, or when the results hold
 // a plot the truth does not know (results of another field): the message names both files'

@@ -10,7 +10,7 @@
 // channel the Bayer filter passes at that pixel, rounded to 8 bits: the camera's RAW8.
 //
 // Thread contract: MeshRenderDevice and MeshRenderScene are thread-compatible once built;
-// renderMeshFrame and visibleFromAny only read the scene and may run concurrently on it. The work
+// renderMeshFrame and camerasSeeing only read the scene and may run concurrently on it. The work
 // inside one call runs on OpenCV's thread pool (cv::parallel_for_). Output depends only on the
 // inputs and the noise key, not on thread count or scheduling.
 #pragma once
@@ -99,11 +99,12 @@ struct MeshFrame {
 MeshFrame renderMeshFrame(const MeshRenderScene& scene, const MeshCamera& camera,
                           const cv::Mat& rays, const MeshRenderOptions& options);
 
-// For each point, whether some camera sees it: inside its image (distortion applied) and nothing
-// of the scene between the camera and the point (1 mm before it).
-std::vector<std::uint8_t> visibleFromAny(const MeshRenderScene& scene,
-                                         const std::vector<MeshCamera>& cameras,
-                                         const std::vector<Eigen::Vector3f>& points);
+// For each point, which of the cameras (at most 8) see it, as a bit mask (bit c: cameras[c]): a
+// camera sees a point inside its image (distortion applied) with nothing of the scene between
+// the camera and the point (1 mm before it).
+std::vector<std::uint8_t> camerasSeeing(const MeshRenderScene& scene,
+                                        const std::vector<MeshCamera>& cameras,
+                                        const std::vector<Eigen::Vector3f>& points);
 
 // The surface a single ray meets first, for tests and truth: distance along the unit
 // direction (infinity when nothing), the part hit (-1 when nothing).

@@ -29,10 +29,15 @@ struct MeshTruthOptions {
 };
 
 struct MeshPlotTruth {
-  PlotCloud visible;          // truth part only: visible plant samples, ground, plants
-  PlotTruthTraits traits;     // the definitions on the visible samples
-  PlotTruthTraits full;       // on all samples within the visible samples' stretch of row
-  std::size_t samples = 0;    // of the imaged plot's plants, before visibility
+  PlotCloud visible;       // truth part only: visible plant samples, ground, plants
+  PlotTruthTraits traits;  // the definitions on the visible samples
+  PlotTruthTraits full;    // on all samples within the visible samples' stretch of row
+  // On the samples both cameras of some head see: what a perfect stereo matcher can place. The
+  // difference to `traits` is plant that only one camera of a pair sees (the ends of the row
+  // within one camera's view, the sides of leaves the other camera sees edge-on).
+  PlotTruthTraits stereo_view;
+  double stereo_view_plant_area_m2 = 0.0;  // of those samples (visible.truth's counterpart)
+  std::size_t samples = 0;                 // of the imaged plot's plants, before visibility
   double view_top_m = 0.0;    // above the ground: the top camera's top-centre ray at the row
   bool exceeds_view = false;  // some plant of the imaged plot reaches above view_top_m
 };
@@ -41,8 +46,8 @@ MeshPlotTruth meshPlotTruth(const MeshRenderScene& scene, const std::vector<Mesh
                             const MeshTruthOptions& options);
 
 // The truth line's mesh fields (added to the fields every synthetic truth line has): traits,
-// areas, the full-geometry traits, the view limit and every plant of the imaged plot with its
-// stem sections.
+// areas, the full-geometry and stereo-view traits, the view limit and every plant of the imaged
+// plot with its stem sections.
 nlohmann::ordered_json meshTruthJson(const MeshPlotTruth& truth, const MeshScene& scene);
 
 }  // namespace fieldrig::sim
