@@ -273,6 +273,10 @@ LinkSummary Acquisition::linkSummary() const {
       summary.packets_missing += link.packets_missing;
       summary.frames_missing_packets += link.frames_missing_packets;
     }
+    if (link.counts_merged_triggers) {
+      summary.counts_merged_triggers = true;
+      summary.triggers_merged += link.triggers_merged;
+    }
     summary.cameras.push_back(
         {i < camera_names_.size() ? camera_names_[i] : "camera" + std::to_string(i), link});
   }

@@ -780,6 +780,8 @@ class Daemon {
     const LinkSummary link = acquisition_->linkSummary();
     summary["packets_resent"] = link.has_packets ? Json(link.packets_resent) : Json(nullptr);
     summary["packets_missing"] = link.has_packets ? Json(link.packets_missing) : Json(nullptr);
+    summary["triggers_merged"] =
+        link.counts_merged_triggers ? Json(link.triggers_merged) : Json(nullptr);
     summary["recording_stopped"] = stats.recording_stopped;
     summary["alarms"] = alarms_total_;
     // How the run went on this machine (not results: they vary from run to run).

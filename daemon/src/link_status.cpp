@@ -10,11 +10,14 @@ nlohmann::ordered_json linkStatusJson(const LinkSummary& link) {
     cameras[camera.name] = {
         {"resent", known(camera.link.has_packets, camera.link.packets_resent)},
         {"missing", known(camera.link.has_packets, camera.link.packets_missing)},
-        {"frames_missing_packets", camera.link.frames_missing_packets}};
+        {"frames_missing_packets", camera.link.frames_missing_packets},
+        {"triggers_merged",
+         known(camera.link.counts_merged_triggers, camera.link.triggers_merged)}};
   }
   return {{"resent", known(link.has_packets, link.packets_resent)},
           {"missing", known(link.has_packets, link.packets_missing)},
           {"frames_missing_packets", link.frames_missing_packets},
+          {"triggers_merged", known(link.counts_merged_triggers, link.triggers_merged)},
           {"cameras", cameras}};
 }
 

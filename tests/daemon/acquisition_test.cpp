@@ -204,6 +204,7 @@ TEST(AcquireCliTest, PrintsTheSummaryContract) {
   // The sim cameras have no packets: the counts are not known, not zero.
   EXPECT_TRUE(summary["packets_resent"].is_null()) << run.out_lines[0];
   EXPECT_TRUE(summary["packets_missing"].is_null()) << run.out_lines[0];
+  EXPECT_TRUE(summary["triggers_merged"].is_null()) << run.out_lines[0];
 }
 
 TEST(AcquisitionTest, SimCamerasReportNoPacketLink) {
@@ -272,6 +273,11 @@ TEST(AcquireCliTest, GigEPacketCountsAreInTheSummary) {
   EXPECT_EQ(summary["sets"], kCount);
   ASSERT_TRUE(summary["packets_resent"].is_number_unsigned()) << run.out_lines[0];
   ASSERT_TRUE(summary["packets_missing"].is_number_unsigned()) << run.out_lines[0];
+  // Frames lost beyond the damaged ones are the camera's merges, which Aravis counts.
+  ASSERT_TRUE(summary["triggers_merged"].is_number_unsigned()) << run.out_lines[0];
+  EXPECT_LE(summary["triggers_merged"].get<std::uint64_t>(),
+            summary["frames_lost"].get<std::uint64_t>())
+      << run.out_lines[0];
   // 40 frames of ~55 packets at 1 % loss: about 22 packets lost; none lost has odds of e^-22.
   EXPECT_GT(summary["packets_resent"].get<std::uint64_t>() +
                 summary["packets_missing"].get<std::uint64_t>(),

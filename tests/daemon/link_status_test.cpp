@@ -13,6 +13,8 @@ drivers::CameraLinkStats gige(std::uint64_t resent, std::uint64_t missing, std::
   link.packets_resent = resent;
   link.packets_missing = missing;
   link.frames_missing_packets = damaged;
+  link.counts_merged_triggers = true;
+  link.triggers_merged = damaged + 1;
   return link;
 }
 
@@ -22,6 +24,8 @@ TEST(LinkStatus, TotalsCountOnlyCamerasWithPacketsAndOthersAreNull) {
   summary.packets_resent = 7 + 2;
   summary.packets_missing = 3 + 0;
   summary.frames_missing_packets = 1 + 0;
+  summary.counts_merged_triggers = true;
+  summary.triggers_merged = 2 + 1;
   summary.cameras = {{"bottom_left", gige(7, 3, 1)},
                      {"bottom_right", gige(2, 0, 0)},
                      {"middle_left", drivers::CameraLinkStats{}}};
@@ -35,6 +39,9 @@ TEST(LinkStatus, TotalsCountOnlyCamerasWithPacketsAndOthersAreNull) {
   EXPECT_EQ(cameras.at("bottom_left").at("missing"), 3);
   EXPECT_EQ(cameras.at("bottom_left").at("frames_missing_packets"), 1);
   EXPECT_EQ(cameras.at("bottom_right").at("resent"), 2);
+  EXPECT_EQ(json.at("triggers_merged"), 3);
+  EXPECT_EQ(cameras.at("bottom_left").at("triggers_merged"), 2);
+  EXPECT_TRUE(cameras.at("middle_left").at("triggers_merged").is_null());
   EXPECT_TRUE(cameras.at("middle_left").at("resent").is_null());
   EXPECT_TRUE(cameras.at("middle_left").at("missing").is_null());
   // In the rig's order, as the page lists cameras.
@@ -48,6 +55,7 @@ TEST(LinkStatus, NoCameraWithPacketsGivesNullTotals) {
   EXPECT_TRUE(json.at("resent").is_null());
   EXPECT_TRUE(json.at("missing").is_null());
   EXPECT_EQ(json.at("frames_missing_packets"), 0);
+  EXPECT_TRUE(json.at("triggers_merged").is_null());
 }
 
 }  // namespace

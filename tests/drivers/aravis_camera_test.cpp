@@ -448,6 +448,9 @@ TEST_F(AravisGigETest, MergedTriggersNeverShiftLaterFramesIds) {
   EXPECT_EQ(frames.size(), stats.frames_delivered);
   EXPECT_LE(stats.triggers_merged, stats.frames_lost);
   EXPECT_GT(stats.triggers_merged, 0u) << "no burst was merged: the test provoked nothing";
+  // The same count reaches the summaries and the status through the link stats.
+  EXPECT_TRUE(camera->linkStats().counts_merged_triggers);
+  EXPECT_EQ(camera->linkStats().triggers_merged, stats.triggers_merged);
   // Every whole frame of the fake carries the host's clock: all were matched by time.
   std::uint64_t whole = 0;
   for (const Seen& frame : frames)

@@ -131,6 +131,9 @@ int runAcquire(const AcquireArgs& args) {
   summary["skew_flagged"] = s.rig.skew_flagged;
   summary["packets_resent"] = packets(link.packets_resent);
   summary["packets_missing"] = packets(link.packets_missing);
+  // A frame lost without a missing packet: the camera merged its trigger into an earlier one.
+  summary["triggers_merged"] =
+      link.counts_merged_triggers ? Json(link.triggers_merged) : Json(nullptr);
   summary["mb_per_s"] = static_cast<double>(s.bytes_written) / 1e6 / seconds;
   summary["sets_per_s"] = static_cast<double>(s.sets_recorded) / seconds;
   summary["cpu_ms_per_set"] =

@@ -655,6 +655,8 @@ CameraLinkStats AravisCamera::linkStats() const {
   link.packets_resent = s.packets_resent;
   link.packets_missing = s.packets_missing;
   link.frames_missing_packets = s.status_missing_packets;
+  link.counts_merged_triggers = true;
+  link.triggers_merged = s.triggers_merged;
   return link;
 }
 

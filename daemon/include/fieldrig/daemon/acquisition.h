@@ -70,6 +70,8 @@ struct LinkSummary {
   std::uint64_t packets_resent = 0;
   std::uint64_t packets_missing = 0;
   std::uint64_t frames_missing_packets = 0;
+  bool counts_merged_triggers = false;  // some camera's driver counts them
+  std::uint64_t triggers_merged = 0;
   std::vector<Camera> cameras;  // rig order
 };
 

@@ -44,6 +44,11 @@ struct CameraLinkStats {
   std::uint64_t packets_resent = 0;   // came back after a resend request
   std::uint64_t packets_missing = 0;  // never came, resends included: their frames are damaged
   std::uint64_t frames_missing_packets = 0;  // delivered marked corrupt for missing packets
+  // Triggers the camera folded into the exposure of an earlier one, so that their frames were
+  // never taken (the camera, not the link, was late). Known only where the driver can tell from
+  // the camera's own timestamps (Aravis); false elsewhere, and the count is then not known.
+  bool counts_merged_triggers = false;
+  std::uint64_t triggers_merged = 0;
 };
 
 class Camera {
