@@ -167,17 +167,27 @@ def main():
 
     print("\nPer head, stereo against the per-pixel truth (vegetation pixels inside the depth crop; "
           "bad = |disparity error| > 2 px at matching resolution, of the matched pixels); "
-          "points in the fused cloud")
+          "points in the fused cloud, and of stereo's points those > 3 cm off the truth surface "
+          "on their ray (or on sky), with the worst plot's share")
     print("| head | plots seen | vegetation px | matched | bad | median abs depth error | "
-          "median depth error | points (b) | points (c) |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+          "median depth error | points (b) | points (c) | (c) off surface | worst plot | "
+          "on sky |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     heads = {}
     for p in plots:
         for head in from_stereo.get(p, {}).get("heads", []):
             h = heads.setdefault(head["name"], {"plots": 0, "pixels": 0, "matched": 0.0,
                                                 "bad": 0.0, "abs": [], "signed": [],
-                                                "points_b": 0, "points_c": 0})
+                                                "points_b": 0, "points_c": 0, "scored": 0,
+                                                "off": 0.0, "sky": 0.0, "off_worst": 0.0})
             h["points_c"] += head.get("points", 0)
+            cloud_score = head.get("points_vs_truth")
+            if cloud_score and cloud_score["points"]:
+                n = cloud_score["points"]
+                h["scored"] += n
+                h["off"] += cloud_score["off_surface_3cm_fraction"] * n
+                h["sky"] += cloud_score["on_sky_fraction"] * n
+                h["off_worst"] = max(h["off_worst"], cloud_score["off_surface_3cm_fraction"])
             score = head.get("stereo_vs_truth")
             if not score or not score["vegetation_pixels"]:
                 continue
@@ -197,14 +207,19 @@ def main():
         bad = h["bad"] / h["matched"] if h["matched"] else 0.0
         med_abs = statistics.median(h["abs"]) if h["abs"] else 0.0
         med = statistics.median(h["signed"]) if h["signed"] else 0.0
+        off = h["off"] / h["scored"] if h["scored"] else 0.0
+        sky = h["sky"] / h["scored"] if h["scored"] else 0.0
         summary["heads"][name] = {"plots": h["plots"], "vegetation_pixels": h["pixels"],
                                   "matched_fraction": matched, "bad_fraction": bad,
                                   "median_abs_depth_error_m": med_abs,
                                   "median_depth_error_m": med, "points_truth_depth": h["points_b"],
-                                  "points_stereo": h["points_c"]}
+                                  "points_stereo": h["points_c"], "off_surface_3cm_fraction": off,
+                                  "off_surface_worst_plot": h["off_worst"],
+                                  "on_sky_fraction": sky}
         print(f"| {name} | {h['plots']} | {h['pixels']} | {100 * matched:.1f} % | "
               f"{100 * bad:.1f} % | {1000 * med_abs:.1f} mm | {1000 * med:+.1f} mm | "
-              f"{h['points_b']} | {h['points_c']} |")
+              f"{h['points_b']} | {h['points_c']} | {100 * off:.1f} % | "
+              f"{100 * h['off_worst']:.1f} % | {100 * sky:.2f} % |")
     print("(depth errors: the median over plots of each plot's median)")
     print(json.dumps({"summary": summary}))
 

@@ -77,6 +77,12 @@ nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::Pl
                                       {"median_abs_depth_error_m", score.median_abs_depth_error_m},
                                       {"median_depth_error_m", score.median_depth_error_m}};
     }
+    if (head.cloud_score) {
+      head_json["points_vs_truth"] = {
+          {"points", head.cloud_score->points},
+          {"off_surface_3cm_fraction", head.cloud_score->off_surface_fraction},
+          {"on_sky_fraction", head.cloud_score->on_sky_fraction}};
+    }
     heads.push_back(std::move(head_json));
   }
   line["heads"] = std::move(heads);

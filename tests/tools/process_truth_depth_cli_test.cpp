@@ -94,6 +94,20 @@ TEST(ProcessTruthDepthCli, TruthDepthGoesThroughTheSameChainAndStereoIsScoredAga
   EXPECT_LT(bad, 0.5) << score.dump();
   EXPECT_LT(score.at("median_abs_depth_error_m").get<double>(), 0.02) << score.dump();
   EXPECT_LT(std::abs(score.at("median_depth_error_m").get<double>()), 0.02) << score.dump();
+
+  // The head's points against the truth on their rays: every point counted, most of them on the
+  // surface (the sky mask and the edge filter have done their part), and the truth depth's own
+  // head has no such score.
+  const Json& points = stereo_bottom.at("points_vs_truth");
+  // (The score's depth range is along the head's axis, the cloud's crop along the plot's; the
+  // bottom head looks level, so they agree.)
+  EXPECT_NEAR(points.at("points").get<double>(), stereo_bottom.at("points").get<double>(),
+              0.02 * stereo_bottom.at("points").get<double>())
+      << points.dump();
+  const double off = points.at("off_surface_3cm_fraction").get<double>();
+  EXPECT_GE(off, points.at("on_sky_fraction").get<double>()) << points.dump();
+  EXPECT_LT(off, 0.25) << points.dump();
+  EXPECT_FALSE(truth_bottom.contains("points_vs_truth"));
 }
 
 TEST(ProcessTruthDepthCli, ASessionWithoutTruthMapsIsRefusedNamingTheMissingFile) {

@@ -163,17 +163,23 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
         return;
       }
       measureCoverage(output->disparity, status);
+      std::optional<cv::Mat> truth_disparity;
       if (!truth_depth && !head.left_truth_depth.empty() && !head.left_truth_vegetation.empty()) {
         const stereo::TruthDepthRectifier& truth = heads_[i].truthDepth();
-        core::Result<cv::Mat> truth_disparity = truth.disparity(head.left_truth_depth);
+        core::Result<cv::Mat> disparity = truth.disparity(head.left_truth_depth);
         core::Result<cv::Mat> vegetation = truth.rectifyMask(head.left_truth_vegetation);
-        if (truth_disparity && vegetation) {
-          status.stereo_score = truth.score(output->disparity, *truth_disparity, *vegetation,
+        if (disparity && vegetation) {
+          status.stereo_score = truth.score(output->disparity, *disparity, *vegetation,
                                             options_.min_depth_m, options_.max_depth_m);
+          truth_disparity = std::move(*disparity);
         }
       }
       if (options_.edge_max_jump_px > 0)
         status.edge_pixels = dropDepthEdges(output->disparity, options_.edge_max_jump_px);
+      if (truth_disparity) {
+        status.cloud_score = heads_[i].truthDepth().scoreCloud(
+            output->disparity, *truth_disparity, options_.min_depth_m, options_.max_depth_m);
+      }
       status.points = appendReprojected(
           output->disparity, output->left_bgr, heads_[i].matchingCalibration().Q, to_plot_[i],
           options_.min_depth_m, options_.max_depth_m, head_clouds[i], &status.reproject_ms);

@@ -143,4 +143,57 @@ DisparityTruthScore TruthDepthRectifier::score(const cv::Mat& measured, const cv
   return out;
 }
 
+CloudTruthScore TruthDepthRectifier::scoreCloud(const cv::Mat& measured, const cv::Mat& truth,
+                                                double min_depth_m, double max_depth_m,
+                                                double tolerance_m) const {
+  CV_Assert(measured.type() == CV_32F && truth.type() == CV_32F && measured.size() == truth.size());
+  const cv::Matx44d& q = q_;
+  const auto depthOf = [&q](int u, int v, double d) {
+    return (q(2, 0) * u + q(2, 1) * v + q(2, 2) * d + q(2, 3)) /
+           (q(3, 0) * u + q(3, 1) * v + q(3, 2) * d + q(3, 3));
+  };
+  CloudTruthScore out;
+  std::size_t off = 0, sky = 0;
+  for (int v = 0; v < truth.rows; ++v) {
+    const auto* m = measured.ptr<float>(v);
+    for (int u = 0; u < truth.cols; ++u) {
+      if (!(m[u] > 0))
+        continue;
+      const double z = depthOf(u, v, m[u]);
+      if (!(z > min_depth_m && z <= max_depth_m))
+        continue;
+      ++out.points;
+      // Near the surface if the truth on this ray or one up to `kRadius` pixels away (a few mm
+      // across at the plants' range: a leaf's rim pixel whose centre ray passes beside the leaf,
+      // or the matcher's block smearing a leaf's depth a pixel or two onto what is behind it) is
+      // within tolerance.
+      constexpr int kRadius = 2;
+      bool any_surface = false;
+      bool near = false;
+      for (int dv = -kRadius; dv <= kRadius && !near; ++dv) {
+        const int vv = v + dv;
+        if (vv < 0 || vv >= truth.rows)
+          continue;
+        const auto* tn = truth.ptr<float>(vv);
+        for (int du = -kRadius; du <= kRadius && !near; ++du) {
+          const int uu = u + du;
+          if (uu < 0 || uu >= truth.cols || !(tn[uu] > 0))
+            continue;
+          any_surface = true;
+          near = std::abs(z - depthOf(uu, vv, tn[uu])) <= tolerance_m;
+        }
+      }
+      if (!any_surface)
+        ++sky;
+      if (!near)
+        ++off;
+    }
+  }
+  if (out.points) {
+    out.off_surface_fraction = static_cast<double>(off) / static_cast<double>(out.points);
+    out.on_sky_fraction = static_cast<double>(sky) / static_cast<double>(out.points);
+  }
+  return out;
+}
+
 }  // namespace fieldrig::stereo

@@ -117,5 +117,44 @@ TEST(TruthDepth, TheScoreCountsMatchedAndBadPixelsAndTheDepthError) {
   EXPECT_EQ(truth->score(measured, truth_disparity, mask, 0.2, 0.5 * z40).pixels, 0U);
 }
 
+TEST(TruthDepth, CloudScoreCountsPointsOffTheSurfaceAndOnSky) {
+  const StereoCalibration full = distortedPair();
+  const StereoCalibration scaled = full.scaled(0.5);
+  auto truth = TruthDepthRectifier::create(scaled, full.image_size, 0.5);
+  ASSERT_TRUE(truth) << truth.error().message;
+  const cv::Size size = scaled.image_size;
+  const cv::Matx44d q(scaled.Q);
+  auto depthAt = [&q](double d) { return q(2, 3) / (q(3, 2) * d + q(3, 3)); };
+  // Truth: 40 px, except the top quarter of rows, which is sky. Measured: the left quarter of
+  // columns unmatched; a disparity 40 px elsewhere, except one column band 6 px nearer, which at
+  // this depth is several cm off the surface; the sky quarter got matches (as sky does).
+  cv::Mat truth_disparity(size, CV_32F, cv::Scalar(40.0f));
+  truth_disparity(cv::Rect(0, 0, size.width, size.height / 4)).setTo(kInvalidDisparity);
+  cv::Mat measured(size, CV_32F, cv::Scalar(40.0f));
+  measured(cv::Rect(0, 0, size.width / 4, size.height)).setTo(kInvalidDisparity);
+  measured(cv::Rect(size.width / 2, 0, size.width / 4, size.height)).setTo(46.0f);
+  ASSERT_GT(depthAt(40.0) - depthAt(46.0), 0.03) << "the test's off band must be off";
+  const CloudTruthScore score = truth->scoreCloud(measured, truth_disparity, 0.2, 5.0);
+  EXPECT_EQ(score.points, static_cast<std::size_t>(size.height) * (size.width - size.width / 4));
+  // Of the matched three quarters of columns: the sky rows (a quarter) are off and on sky; of the
+  // rest, the band (a third of the matched columns) is off. (The two rows beside the sky see
+  // surface on neighbouring rays: a few pixels' worth, inside the tolerance.)
+  EXPECT_NEAR(score.on_sky_fraction, 0.25, 0.01);
+  EXPECT_NEAR(score.off_surface_fraction, 0.25 + 0.75 / 3.0, 0.01);
+  // A point a pixel beside a surface edge is on it: the last sky row next to the surface.
+  cv::Mat one_point(size, CV_32F, cv::Scalar(kInvalidDisparity));
+  one_point.at<float>(size.height / 4 - 1, size.width / 4) = 40.0f;
+  const CloudTruthScore rim = truth->scoreCloud(one_point, truth_disparity, 0.2, 5.0);
+  ASSERT_EQ(rim.points, 1U);
+  EXPECT_EQ(rim.off_surface_fraction, 0.0);
+  EXPECT_EQ(rim.on_sky_fraction, 0.0);
+  one_point.at<float>(size.height / 4 - 1, size.width / 4) = kInvalidDisparity;
+  one_point.at<float>(size.height / 4 - 3, size.width / 4) = 40.0f;  // three rows into the sky
+  EXPECT_EQ(truth->scoreCloud(one_point, truth_disparity, 0.2, 5.0).on_sky_fraction, 1.0);
+  // A tolerance wider than the band's error takes it back onto the surface.
+  EXPECT_NEAR(truth->scoreCloud(measured, truth_disparity, 0.2, 5.0, 1.0).off_surface_fraction,
+              0.25, 0.01);
+}
+
 }  // namespace
 }  // namespace fieldrig::stereo

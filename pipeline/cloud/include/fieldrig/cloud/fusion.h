@@ -48,6 +48,8 @@ struct HeadStatus {
   // rectified truth depth lies in (min_depth_m, max_depth_m] (about the plot frame's depth crop),
   // before the edge filter; bad = |disparity error| > 2 px at matching resolution.
   std::optional<stereo::DisparityTruthScore> stereo_score;
+  // The same head's points (after the edge filter, in the depth range) against the truth.
+  std::optional<stereo::CloudTruthScore> cloud_score;
   stereo::HeadTimings timings;
   double reproject_ms = 0;  // reprojection, transform into the plot frame, crop, colour
 };

@@ -24,6 +24,16 @@ struct DisparityTruthScore {
   double median_depth_error_m = 0;      // signed: measured − truth (> 0: too far)
 };
 
+// What reaches the cloud: of the pixels with a disparity whose depth lies in (min_depth,
+// max_depth] (after every filter; depth along the head's rectified axis, where the cloud crops
+// along the plot's, the same for a level head), how many sit off the surface the truth has on
+// their ray.
+struct CloudTruthScore {
+  std::size_t points = 0;           // pixels that become points
+  double off_surface_fraction = 0;  // depth more than tolerance from the truth's, or on sky
+  double on_sky_fraction = 0;       // the truth has nothing on that ray
+};
+
 // Thread contract: thread-compatible; disparity(), rectifyMask() and score() are const.
 class TruthDepthRectifier {
  public:
@@ -46,6 +56,14 @@ class TruthDepthRectifier {
   DisparityTruthScore score(const cv::Mat& measured, const cv::Mat& truth, const cv::Mat& mask,
                             double min_depth_m, double max_depth_m,
                             double bad_threshold_px = 2.0) const;
+
+  // The pixels of `measured` that become points against the truth on their rays: a point is off
+  // the surface when its depth differs by more than `tolerance_m` from the truth's on its own ray
+  // and on every ray up to 2 pixels away (a few mm across at the plants' range: a leaf's rim
+  // pixel may match the leaf while its centre ray passes beside it). Along rays, which can only
+  // overstate the distance to the nearest surface. On sky: no surface on any of those rays.
+  CloudTruthScore scoreCloud(const cv::Mat& measured, const cv::Mat& truth, double min_depth_m,
+                             double max_depth_m, double tolerance_m = 0.03) const;
 
  private:
   cv::Size camera_size_;
