@@ -24,6 +24,12 @@ double median(std::vector<double>& values) {
   return *middle;
 }
 
+// The depth Q gives rectified pixel (u, v) at disparity d.
+double rectifiedDepth(const cv::Matx44d& q, int u, int v, double d) {
+  return (q(2, 0) * u + q(2, 1) * v + q(2, 2) * d + q(2, 3)) /
+         (q(3, 0) * u + q(3, 1) * v + q(3, 2) * d + q(3, 3));
+}
+
 }  // namespace
 
 core::Result<TruthDepthRectifier> TruthDepthRectifier::create(const StereoCalibration& scaled,
@@ -105,11 +111,7 @@ DisparityTruthScore TruthDepthRectifier::score(const cv::Mat& measured, const cv
                                                double max_depth_m, double bad_threshold_px) const {
   CV_Assert(measured.type() == CV_32F && truth.type() == CV_32F && mask.type() == CV_8UC1 &&
             measured.size() == truth.size() && mask.size() == truth.size());
-  const cv::Matx44d& q = q_;
-  const auto depthOf = [&q](int u, int v, double d) {
-    return (q(2, 0) * u + q(2, 1) * v + q(2, 2) * d + q(2, 3)) /
-           (q(3, 0) * u + q(3, 1) * v + q(3, 2) * d + q(3, 3));
-  };
+  const auto depthOf = [this](int u, int v, double d) { return rectifiedDepth(q_, u, v, d); };
   DisparityTruthScore out;
   std::size_t matched = 0, bad = 0;
   std::vector<double> errors, abs_errors;
@@ -147,11 +149,7 @@ CloudTruthScore TruthDepthRectifier::scoreCloud(const cv::Mat& measured, const c
                                                 double min_depth_m, double max_depth_m,
                                                 double tolerance_m) const {
   CV_Assert(measured.type() == CV_32F && truth.type() == CV_32F && measured.size() == truth.size());
-  const cv::Matx44d& q = q_;
-  const auto depthOf = [&q](int u, int v, double d) {
-    return (q(2, 0) * u + q(2, 1) * v + q(2, 2) * d + q(2, 3)) /
-           (q(3, 0) * u + q(3, 1) * v + q(3, 2) * d + q(3, 3));
-  };
+  const auto depthOf = [this](int u, int v, double d) { return rectifiedDepth(q_, u, v, d); };
   CloudTruthScore out;
   std::size_t off = 0, sky = 0;
   for (int v = 0; v < truth.rows; ++v) {
