@@ -90,6 +90,7 @@ nlohmann::ordered_json traitsToJson(const TraitsResult& r, bool with_slices) {
                   {"points_ground_tilted", q.points_ground_tilted},
                   {"points_plants", q.points_plants},
                   {"points_beyond_row", q.points_beyond_row},
+                  {"row_coverage", q.row_coverage},
                   {"points_outside_box", q.points_outside_box},
                   {"icp_fitness_coarse", q.icp_fitness_coarse},
                   {"icp_fitness_fine", q.icp_fitness_fine},

@@ -250,6 +250,7 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& all_plant
   result.y_min = lo.y();
   result.y_max = hi.y();
   const double row_extent = result.y_max - result.y_min;
+  result.quality.row_coverage = row_extent / options.row_length_m;
   if (row_extent < options.min_row_extent_m)
     return failed(std::move(result), TraitsStatus::kSingleSlice,
                   "plants span " + std::to_string(row_extent) + " m along the row, need " +

@@ -66,6 +66,24 @@ TEST(TraitsTruth, CameraFrameInputGivesThePlotFrameResult) {
   EXPECT_NEAR(in_camera.vvi, in_plot.vvi, 1e-3);
 }
 
+TEST(TraitsTruth, RowCoverageSaysHowMuchOfThePlotWasSeen) {
+  const sim::PlotCloud plot = sim::generatePlot(testSpec(1.5, 0.003, 25));
+  const TraitsOptions options;  // row_length_m 1.5, as the generator's row
+  const TraitsResult whole = computeTraits(plot.points, InputFrame::kPlot, options);
+  ASSERT_EQ(whole.status, TraitsStatus::kOk) << whole.message;
+  EXPECT_GT(whole.quality.row_coverage, 0.95);
+  EXPECT_LT(whole.quality.row_coverage, 1.3) << "leaves reach a little beyond the ends";
+  // Cameras that saw only the first half of the row: the plants' points span half of it.
+  std::vector<Eigen::Vector3f> first_half;
+  for (const Eigen::Vector3f& p : plot.points) {
+    if (p.y() < 0.0F)
+      first_half.push_back(p);
+  }
+  const TraitsResult half = computeTraits(first_half, InputFrame::kPlot, options);
+  ASSERT_EQ(half.status, TraitsStatus::kOk) << half.message;
+  EXPECT_NEAR(half.quality.row_coverage, 0.5 + (whole.quality.row_coverage - 1.0) / 2.0, 0.05);
+}
+
 TEST(TraitsTruth, TiltedGroundIsFoundByTheRegistration) {
   sim::PlotSpec spec = testSpec(1.5, 0.003, 24);
   spec.ground_tilt_deg = 4.0;

@@ -126,6 +126,10 @@ struct TraitsQuality {
   std::size_t points_ground_tilted = 0;  // below the 10-degree tilted planes only
   std::size_t points_plants = 0;
   std::size_t points_beyond_row = 0;  // plant points beyond ±row_length_m / 2 (crop_to_row_length)
+  // How much of the plot's row length the plant points span (y_max − y_min over row_length_m):
+  // well under 1 when the cameras saw part of the plot; a little over 1 from leaves reaching
+  // beyond its ends when crop_to_row_length is off.
+  double row_coverage = 0.0;
   std::size_t points_outside_box = 0;
   double icp_fitness_coarse = -1.0;  // mean squared correspondence distance, m^2 (-1: not run)
   double icp_fitness_fine = -1.0;
