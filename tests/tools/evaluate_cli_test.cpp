@@ -134,6 +134,20 @@ TEST_F(EvaluateCli, TruthViewScoresAgainstTheNamedBlockOfEachTruthLine) {
   EXPECT_NEAR(width["max_abs"].get<double>(), 0.06, 1e-9);
   EXPECT_EQ(width["worst_plot"], "B");
 
+  // A view block whose traits failed is not scored against its zeros: B's stereo view has no
+  // plants, so only A is scored (width error 0) and B is named.
+  Json b = Json::parse(meshLine("B", 2.00, 0.80, 0.50));
+  b["stereo_view"] = {{"status", "no_plants"}, {"height_m", 0.0}, {"width_m", 0.0}, {"vvi", 0.0}};
+  writeLines(truth, {meshLine("A", 1.00, 0.50, 0.40), b.dump(), meshLine("C", 1.50, 0.60, 0.20)});
+  const auto failed_view = runFieldrig({"evaluate", results_dir.string(), "--truth", truth.string(),
+                                        "--truth-view", "stereo", "--summary-only"},
+                                       dir.path());
+  ASSERT_EQ(failed_view.exit_code, 0) << failed_view.err;
+  const Json failed_summary = Json::parse(failed_view.out_lines.back())["summary"];
+  EXPECT_EQ(failed_summary["truth_not_ok"], Json::array({"B"}));
+  EXPECT_EQ(failed_summary["width_m"]["plots"], 1);
+  EXPECT_NEAR(failed_summary["width_m"]["max_abs"].get<double>(), 0.0, 1e-9);
+
   // A truth without that block (the fixture's plain lines, or a field simulated before the
   // block existed) is refused with the line, not scored against the seen view.
   writeLines(truth, {truthLine("A", 1.00, 0.50, 0.40)});

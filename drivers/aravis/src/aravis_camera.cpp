@@ -655,7 +655,9 @@ CameraLinkStats AravisCamera::linkStats() const {
   link.packets_resent = s.packets_resent;
   link.packets_missing = s.packets_missing;
   link.frames_missing_packets = s.status_missing_packets;
-  link.counts_merged_triggers = true;
+  // Merges are seen only by matching frames by the camera's timestamps; a camera on another
+  // clock is matched in order, and its count would read 0 without meaning it.
+  link.counts_merged_triggers = s.frames_matched_by_time > 0;
   link.triggers_merged = s.triggers_merged;
   return link;
 }

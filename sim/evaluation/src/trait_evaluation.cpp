@@ -145,6 +145,12 @@ core::Result<TraitEvaluation> evaluateTraits(const std::vector<PlotTraitValues>&
       evaluation.missing_in_results.push_back(true_plot.plot);
       continue;
     }
+    // A truth whose own traits failed (a view block with too little plant in it) has no values
+    // to score against: its zeros would read as errors of the pipeline.
+    if (true_plot.status != "ok") {
+      evaluation.truth_not_ok.push_back(true_plot.plot);
+      continue;
+    }
     const PlotTraitValues& measured = *found->second;
     PlotComparison comparison{measured.plot, measured.status, {}};
     if (measured.status != "ok")
@@ -164,8 +170,13 @@ core::Result<TraitEvaluation> evaluateTraits(const std::vector<PlotTraitValues>&
     }
     evaluation.plots.push_back(std::move(comparison));
   }
-  if (evaluation.plots.empty())
+  if (evaluation.plots.empty()) {
+    if (!evaluation.truth_not_ok.empty())
+      return core::Error{"no truth plot has status ok (" + evaluation.truth_not_ok.front() +
+                         " and " + std::to_string(evaluation.truth_not_ok.size() - 1) +
+                         " more): nothing to score against"};
     return core::Error{"results and truth share no plot id"};
+  }
   for (const auto& [trait, list] : errors) {
     TraitSummary summary;
     summary.plots = static_cast<int>(list.size());
@@ -189,6 +200,7 @@ nlohmann::ordered_json evaluationJson(const TraitEvaluation& evaluation) {
   out["plots"] = evaluation.plots.size();
   out["scored"] = evaluation.plots.size() - evaluation.not_ok.size();
   out["not_ok"] = evaluation.not_ok;
+  out["truth_not_ok"] = evaluation.truth_not_ok;
   out["missing_in_results"] = evaluation.missing_in_results;
   for (const ComparedTrait& trait : kComparedTraits) {
     const auto found = evaluation.summary.find(trait.name);

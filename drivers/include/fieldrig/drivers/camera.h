@@ -46,7 +46,8 @@ struct CameraLinkStats {
   std::uint64_t frames_missing_packets = 0;  // delivered marked corrupt for missing packets
   // Triggers the camera folded into the exposure of an earlier one, so that their frames were
   // never taken (the camera, not the link, was late). Known only where the driver can tell from
-  // the camera's own timestamps (Aravis); false elsewhere, and the count is then not known.
+  // the camera's own timestamps (Aravis, once a frame was matched by them); false elsewhere, and
+  // the count is then not known.
   bool counts_merged_triggers = false;
   std::uint64_t triggers_merged = 0;
 };

@@ -56,6 +56,7 @@ struct TraitEvaluation {
   std::vector<PlotComparison> plots;            // in the truth's order
   std::vector<std::string> missing_in_results;  // truth plots the results do not have
   std::vector<std::string> not_ok;              // results whose status is not "ok" (not scored)
+  std::vector<std::string> truth_not_ok;        // truth plots whose status is not "ok" (skipped)
   std::map<std::string, TraitSummary> summary;  // per trait over the scored plots
 };
 
