@@ -46,4 +46,7 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -q
   apt-get install -y -q --no-install-recommends "${missing[@]}"
+  # The downloaded .deb files (1.5 GB, most of it VTK, Chromium and LLVM) are not needed once
+  # installed; CI's disk has run out with them kept.
+  apt-get clean
 fi
