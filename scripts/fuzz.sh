@@ -83,8 +83,8 @@ main() {
       # config.cpp calls the option checks of the cloud, the matcher and the traits and the
       # fsync policy's parser; the file that holds TraitsOptions::validate() also holds the
       # traits, whose steps need PCL: those few files are compiled in, not their libraries.
-      sources=(config/src/config.cpp pipeline/cloud/src/cloud_options.cpp
-               pipeline/stereo/src/matcher.cpp
+      sources=(config/src/config.cpp config/src/traits_config.cpp
+               pipeline/cloud/src/cloud_options.cpp pipeline/stereo/src/matcher.cpp
                pipeline/traits/src/plot_traits.cpp pipeline/traits/src/depth_map_area.cpp
                pipeline/traits/src/sparse_outliers.cpp pipeline/traits/src/pcl_steps.cpp
                pipeline/traits/src/paper_area.cpp recording/src/session_format.cpp

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "fieldrig/cloud/cloud_options.h"
+#include "fieldrig/config/traits_config.h"
 #include "fieldrig/core/result.h"
 #include "fieldrig/core/rig_layout.h"
 #include "fieldrig/drivers/rig.h"
@@ -113,10 +114,5 @@ core::Result<Config> loadConfig(const std::filesystem::path& file);
 // The same from text; `origin` names it in errors and relative paths resolve against `base_dir`.
 core::Result<Config> parseConfig(const std::string& text, const std::string& origin,
                                  const std::filesystem::path& base_dir);
-
-// Traits options alone (`fieldrig traits --config`, `fieldrig process --traits-config`): a YAML
-// file with the keys of the `pipeline.traits` section at its top. JSON is YAML, so the JSON files
-// of earlier versions still load (their area_method name "paper_mls_gpt" is read as "paper").
-core::Result<traits::TraitsOptions> loadTraitsOptions(const std::filesystem::path& file);
 
 }  // namespace fieldrig::config
