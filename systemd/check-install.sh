@@ -67,6 +67,17 @@ if [[ $binaries == 1 ]]; then
       fail "missing or not executable: $bindir/$program"
     fi
   done
+  # The launcher finds the programs it runs in the installed layout (libexec/fieldrig), not only in
+  # the build tree: the full tool for the help, the light one for `traits`.
+  launcher=$stage$bindir/fieldrig
+  if [[ -x $launcher ]]; then
+    help=$("$launcher" --help 2>&1) || true
+    grep -q "evaluate" <<<"$help" ||
+      fail "$bindir/fieldrig --help does not list the subcommands: $help"
+    help=$("$launcher" traits --help 2>&1) || true
+    grep -q -- "--cloud" <<<"$help" ||
+      fail "$bindir/fieldrig traits --help does not show --cloud: $help"
+  fi
 else
   echo "check-install: fieldrigd not installed yet (no target or install.cmake not included):" \
     "binaries not checked"

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   registerDisparityCommand(app, exit_code);
   registerCloudCommand(app, exit_code);
   registerTraitsCommand(app, exit_code);
+  registerTraitsSynthCommand(app, exit_code);
   registerStemCommand(app, exit_code);
   registerStemUiCommand(app, exit_code);
   registerViewCommand(app, exit_code);

@@ -1,8 +1,11 @@
 // `fieldrig traits` contract: the real binary on a synthetic plot written by `traits synth`.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "support/cli_run.h"
 #include "support/temp_dir.h"
@@ -130,6 +133,46 @@ TEST(TraitsCli, EmptyCloudIsAResultWithAStatus) {
   const nlohmann::json out = nlohmann::json::parse(run.out_lines.at(0));
   EXPECT_EQ(out.at("status"), "empty_cloud");
   EXPECT_TRUE(out.at("height_m").is_null());
+}
+
+// `fieldrig` is a launcher: `traits` runs the light fieldrig-traits, everything else (and
+// `traits synth`) the full fieldrig-commands. The light program's help says where the rest is.
+TEST(TraitsCli, TraitsRunsTheLightProgramAndEverythingElseTheFullOne) {
+  ScopedTempDir dir("traits_cli_launcher");
+  const std::string light_footer = "The other subcommands, and `traits synth`: fieldrig --help.";
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"traits", "--help"},
+        std::vector<std::string>{"--log-level", "info", "traits", "--help"}}) {
+    const CliRun help = runFieldrig(args, dir.path());
+    EXPECT_EQ(help.exit_code, 0) << help.err;
+    std::string out;
+    for (const std::string& line : help.out_lines)
+      out += line + "\n";
+    EXPECT_NE(out.find("--cloud"), std::string::npos) << out;
+    EXPECT_NE(out.find(light_footer), std::string::npos) << out;
+  }
+  const CliRun synth = runFieldrig({"traits", "synth", "--help"}, dir.path());
+  EXPECT_EQ(synth.exit_code, 0) << synth.err;
+  std::string synth_out;
+  for (const std::string& line : synth.out_lines)
+    synth_out += line + "\n";
+  EXPECT_NE(synth_out.find("--no-plants"), std::string::npos) << synth_out;
+  EXPECT_EQ(synth_out.find(light_footer), std::string::npos) << synth_out;
+
+  // What makes it light: none of OpenCV (whose image codecs pull in GDAL and ~140 libraries) or
+  // the camera libraries is loaded. VTK still is, through PCL's surface module (hulls, MLS).
+  const std::filesystem::path light =
+      std::filesystem::path(kFieldrigBinary).parent_path() / "fieldrig-traits";
+  ASSERT_TRUE(std::filesystem::exists(light)) << light;
+  const CliRun libraries = runProgram("ldd", {light.string()}, dir.path());
+  ASSERT_EQ(libraries.exit_code, 0) << libraries.err;
+  ASSERT_GT(libraries.out_lines.size(), 3U);
+  // 38 on Debian 12 (fieldrig-commands: 219).
+  EXPECT_LT(libraries.out_lines.size(), 80U);
+  for (const std::string& line : libraries.out_lines) {
+    for (const char* heavy : {"libopencv", "libgdal", "libaravis", "libdc1394"})
+      EXPECT_EQ(line.find(heavy), std::string::npos) << light << " loads " << line;
+  }
 }
 
 }  // namespace

@@ -26,6 +26,8 @@ void registerCalibrateCommand(CLI::App& app, int& exit_code);
 void registerDisparityCommand(CLI::App& app, int& exit_code);
 void registerCloudCommand(CLI::App& app, int& exit_code);
 void registerTraitsCommand(CLI::App& app, int& exit_code);
+// `traits synth`, added to the `traits` subcommand (registerTraitsCommand first).
+void registerTraitsSynthCommand(CLI::App& app, int& exit_code);
 void registerStemCommand(CLI::App& app, int& exit_code);
 void registerStemUiCommand(CLI::App& app, int& exit_code);
 void registerViewCommand(CLI::App& app, int& exit_code);
