@@ -330,6 +330,14 @@ core::Result<std::vector<RecordedPlot>> recordMeshPlots(
     line["visible_plant_area_m2"] = truth.visible.truth.visible_plant_area_m2;
     line["renderer"] = "mesh";
     line["stage"] = std::string(stageName(spec.plot.stage));
+    // The soil plane's slopes, and the angle between its normal and the vertical (the rig is level
+    // here): what the traits' ground fit (quality.ground_tilt_deg) should find.
+    line["soil_slope_along_deg"] = spec.slope_along_deg;
+    line["soil_slope_across_deg"] = spec.slope_across_deg;
+    line["soil_tilt_deg"] =
+        std::atan(std::hypot(std::tan(spec.slope_along_deg * std::numbers::pi / 180.0),
+                             std::tan(spec.slope_across_deg * std::numbers::pi / 180.0))) *
+        180.0 / std::numbers::pi;
     const Json mesh_fields = meshTruthJson(truth, (*scene)->scene());
     for (const auto& [key, value] : mesh_fields.items())
       line[key] = value;
