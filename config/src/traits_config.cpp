@@ -51,6 +51,7 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
           {"icp_fine_distance_m", nonNegative(o.icp_fine_distance_m)},
           {"icp_iterations", integer(o.icp_iterations, 1)},
           {"max_ground_tilt_deg", numberIn(o.max_ground_tilt_deg, 0, 90)},
+          {"ground_tilt_limit_deg", numberIn(o.ground_tilt_limit_deg, 0, 90)},
           {"max_ground_shift_m", numberIn(o.max_ground_shift_m, 0, 10)},
           {"ground_margin_m", nonNegative(o.ground_margin_m)},
           {"ground_tilt_deg", numberIn(o.ground_tilt_deg, 0, 90, true)},

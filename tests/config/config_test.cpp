@@ -126,6 +126,7 @@ void expectSame(const traits::TraitsOptions& actual, const traits::TraitsOptions
   EXPECT_FIELD(icp_fine_distance_m);
   EXPECT_FIELD(icp_iterations);
   EXPECT_FIELD(max_ground_tilt_deg);
+  EXPECT_FIELD(ground_tilt_limit_deg);
   EXPECT_FIELD(max_ground_shift_m);
   EXPECT_FIELD(ground_margin_m);
   EXPECT_FIELD(ground_tilt_deg);
@@ -825,6 +826,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
                                   "icp_fine_distance_m: 0\n"
                                   "icp_iterations: 20\n"
                                   "max_ground_tilt_deg: 20\n"
+                                  "ground_tilt_limit_deg: 6\n"
                                   "ground_margin_m: 0.02\n"
                                   "ground_tilt_deg: 12\n"
                                   "row_length_m: 3\n"
@@ -861,6 +863,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
   expected.icp_fine_distance_m = 0;
   expected.icp_iterations = 20;
   expected.max_ground_tilt_deg = 20;
+  expected.ground_tilt_limit_deg = 6;
   expected.ground_margin_m = 0.02;
   expected.ground_tilt_deg = 12;
   expected.row_length_m = 3;

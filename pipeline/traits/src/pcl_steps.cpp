@@ -66,6 +66,26 @@ Points removeStatisticalOutliers(const Points& points, int mean_k, double stddev
   return fromPcl(out);
 }
 
+Eigen::Matrix4d limitTilt(const Eigen::Matrix4d& transform, const Eigen::Vector3d& pivot,
+                          double limit_deg) {
+  const Eigen::Matrix3d r = transform.block<3, 3>(0, 0);
+  const Eigen::Vector3d up = r * Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d axis = Eigen::Vector3d::UnitX().cross(up);
+  const double tilt = std::atan2(axis.norm(), up.x());
+  const double limit = limit_deg * std::numbers::pi / 180.0;
+  if (!(tilt > limit) || axis.norm() < 1e-12)
+    return transform;
+  // r = tilt(θ) · turn, with turn a rotation about x; the result is tilt(limit) · turn.
+  const Eigen::Vector3d unit_axis = axis.normalized();
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(-tilt, unit_axis).toRotationMatrix() * r;
+  const Eigen::Matrix3d limited = Eigen::AngleAxisd(limit, unit_axis).toRotationMatrix() * turn;
+  Eigen::Matrix4d out = Eigen::Matrix4d::Identity();
+  out.block<3, 3>(0, 0) = limited;
+  const Eigen::Vector3d pivot_to = r * pivot + transform.block<3, 1>(0, 3);
+  out.block<3, 1>(0, 3) = pivot_to - limited * pivot;
+  return out;
+}
+
 PlateFit registerPlate(const Points& plate, const Points& target, double coarse_distance,
                        double fine_distance, int iterations, double max_tilt_deg) {
   PlateFit fit;

@@ -27,6 +27,11 @@ struct PlateFit {
 // distance, then a fine one; when the coarse stage tilts the plate beyond max_tilt_deg the fine
 // stage restarts from the data-driven pose (identity here: the template is already placed).
 // fine_distance <= 0 runs the paper's single coarse stage.
+// `transform` with its rotation's tilt (the angle it turns x by) reduced to `limit_deg`, about the
+// axis it tilts around; its turn about the tilted x is kept, and `pivot` stays where it maps to.
+Eigen::Matrix4d limitTilt(const Eigen::Matrix4d& transform, const Eigen::Vector3d& pivot,
+                          double limit_deg);
+
 PlateFit registerPlate(const Points& plate, const Points& target, double coarse_distance,
                        double fine_distance, int iterations, double max_tilt_deg);
 

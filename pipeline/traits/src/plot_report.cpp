@@ -97,6 +97,8 @@ nlohmann::ordered_json traitsToJson(const TraitsResult& r, bool with_slices) {
                   {"icp_converged", q.icp_converged},
                   {"icp_fell_back", q.icp_fell_back},
                   {"ground_tilt_deg", q.ground_tilt_deg},
+                  {"ground_tilt_fitted_deg", q.ground_tilt_fitted_deg},
+                  {"ground_tilt_limited", q.ground_tilt_limited},
                   {"icp_ground_shift_m", q.icp_ground_shift_m},
                   {"ground_from_data_pose", q.ground_from_data_pose},
                   {"base_edge_centre",

@@ -122,6 +122,7 @@ std::optional<OptionsProblem> TraitsOptions::validate() const {
       outOfRange("icp_fine_distance_m", icp_fine_distance_m, 0, 10),
       outOfRange("icp_iterations", icp_iterations, 1, 1000),
       outOfRange("max_ground_tilt_deg", max_ground_tilt_deg, 0, 90),
+      outOfRange("ground_tilt_limit_deg", ground_tilt_limit_deg, 0, 90),
       outOfRange("max_ground_shift_m", max_ground_shift_m, 0, 10),
       outOfRange("ground_margin_m", ground_margin_m, 0, 1),
       outOfRange("ground_tilt_deg", ground_tilt_deg, 0, 90, true),
@@ -500,9 +501,18 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
                                plate_transform.block<3, 1>(0, 3) - data_edge_centre)
                                   .x();
   q.icp_ground_shift_m = ground_shift;
+  q.ground_tilt_fitted_deg = fit.tilt_deg;
   if (std::abs(ground_shift) > options.max_ground_shift_m) {
     plate_transform.setIdentity();
     q.ground_from_data_pose = true;
+    q.ground_tilt_deg = 0.0;
+  } else if (options.ground_tilt_limit_deg > 0.0 && fit.tilt_deg > options.ground_tilt_limit_deg) {
+    // Turn the plate's normal back toward the data's vertical until it leans by the limit, keeping
+    // its turn about the normal and the place of its base-ground edge.
+    plate_transform =
+        detail::limitTilt(plate_transform, data_edge_centre, options.ground_tilt_limit_deg);
+    q.ground_tilt_limited = true;
+    q.ground_tilt_deg = options.ground_tilt_limit_deg;
   }
   const Eigen::Matrix3d r = plate_transform.block<3, 3>(0, 0);
   const Eigen::Vector3d t = plate_transform.block<3, 1>(0, 3);
@@ -545,6 +555,8 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
   traits.quality.icp_ground_shift_m = q.icp_ground_shift_m;
   traits.quality.ground_from_data_pose = q.ground_from_data_pose;
   traits.quality.ground_tilt_deg = q.ground_tilt_deg;
+  traits.quality.ground_tilt_fitted_deg = q.ground_tilt_fitted_deg;
+  traits.quality.ground_tilt_limited = q.ground_tilt_limited;
   traits.quality.base_edge_centre = q.base_edge_centre;
   traits.timings.filter_ms = result.timings.filter_ms;
   traits.timings.ground_ms = result.timings.ground_ms;

@@ -94,6 +94,33 @@ TEST(TraitsTruth, TiltedGroundIsFoundByTheRegistration) {
   EXPECT_NEAR(r.height_m, plotTruth(plot, TraitsOptions{}).definitions.height_m, 0.03);
 }
 
+// Ground steeper than the limit (a furrow's pull, on the field) is turned back to the limit and
+// says so; without a limit the registration's own tilt stands. Soil tilted by 8 degrees.
+TEST(TraitsTruth, GroundTiltBeyondTheLimitIsTurnedBackAndReported) {
+  sim::PlotSpec spec = testSpec(1.5, 0.003, 24);
+  spec.ground_tilt_deg = 8.0;
+  const sim::PlotCloud plot = sim::generatePlot(spec);
+  TraitsOptions free;
+  free.ground_tilt_limit_deg = 0.0;
+  const TraitsResult unlimited = computeTraits(plot.points, InputFrame::kPlot, free);
+  ASSERT_EQ(unlimited.status, TraitsStatus::kOk) << unlimited.message;
+  EXPECT_FALSE(unlimited.quality.ground_tilt_limited);
+  EXPECT_NEAR(unlimited.quality.ground_tilt_deg, 8.0, 1.5);
+  EXPECT_DOUBLE_EQ(unlimited.quality.ground_tilt_fitted_deg, unlimited.quality.ground_tilt_deg);
+
+  TraitsOptions limited_options;
+  limited_options.ground_tilt_limit_deg = 4.0;
+  const TraitsResult limited = computeTraits(plot.points, InputFrame::kPlot, limited_options);
+  ASSERT_EQ(limited.status, TraitsStatus::kOk) << limited.message;
+  EXPECT_TRUE(limited.quality.ground_tilt_limited);
+  EXPECT_DOUBLE_EQ(limited.quality.ground_tilt_deg, 4.0);
+  EXPECT_DOUBLE_EQ(limited.quality.ground_tilt_fitted_deg, unlimited.quality.ground_tilt_deg);
+  // The edge stays where the registration put it; the ground under the row moves, so which points
+  // are plant does too.
+  EXPECT_LT((limited.quality.base_edge_centre - unlimited.quality.base_edge_centre).norm(), 1e-6);
+  EXPECT_NE(limited.quality.points_ground, unlimited.quality.points_ground);
+}
+
 // A plate registration that moves the ground level beyond max_ground_shift_m is not used: the
 // data's densest low layer is the ground, and the result says so. With the guard at 0 any shift
 // trips it; with the default the registration's small correction stands.

@@ -53,6 +53,10 @@ struct TraitsOptions {
   double icp_fine_distance_m = 0.03;   // fine stage, so the plate cannot hang on leaves; 0: none
   int icp_iterations = 10;             // per stage
   double max_ground_tilt_deg = 15.0;   // a registration tilted further is rejected
+  // The steepest ground the field and the rig's attitude allow (soil sloped up to 3 degrees, about
+  // 1 of roll or pitch): a registration tilted further (furrows pull it) is turned back to this
+  // tilt about its base-ground edge (quality.ground_tilt_limited); 0: no limit.
+  double ground_tilt_limit_deg = 4.0;
   // A registration that moves the ground level further than this from the data's lowest dense
   // layer has slid up the plants: the data's layer is used instead (quality.ground_from_data_pose).
   double max_ground_shift_m = 0.05;
@@ -135,9 +139,11 @@ struct TraitsQuality {
   double icp_fitness_fine = -1.0;
   bool icp_converged = false;
   bool icp_fell_back = false;    // the coarse stage tilted too far; fine stage from the data pose
-  double ground_tilt_deg = 0.0;  // angle between the registered ground normal and x
-  double icp_ground_shift_m = 0.0;     // ground level, registered − data's lowest dense layer
-  bool ground_from_data_pose = false;  // the registration moved it too far (max_ground_shift_m)
+  double ground_tilt_deg = 0.0;  // angle between the ground normal used and x
+  double ground_tilt_fitted_deg = 0.0;  // the registration's, before the limit or the data pose
+  bool ground_tilt_limited = false;     // turned back to ground_tilt_limit_deg
+  double icp_ground_shift_m = 0.0;      // ground level, registered − data's lowest dense layer
+  bool ground_from_data_pose = false;   // the registration moved it too far (max_ground_shift_m)
   Eigen::Vector3d base_edge_centre = Eigen::Vector3d::Zero();
   int slices = 0;
   int occupied_slices = 0;
