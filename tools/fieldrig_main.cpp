@@ -4,7 +4,6 @@
 
 #include "commands/command_helpers.h"
 #include "commands/commands.h"
-#include "fieldrig/core/logging.h"
 
 int main(int argc, char** argv) {
   using namespace fieldrig::tools;
@@ -12,9 +11,7 @@ int main(int argc, char** argv) {
   app.footer(kExitCodesHelp);
   app.require_subcommand(1);
   std::string log_level = "warn";
-  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
-      ->capture_default_str();
-  app.parse_complete_callback([&] { fieldrig::core::setupLogging(log_level); });
+  addLogLevelOption(app, log_level);
 
   int exit_code = kExitOk;
   registerNmeaCommand(app, exit_code);

@@ -145,17 +145,13 @@ TEST(TraitsCli, TraitsRunsTheLightProgramAndEverythingElseTheFullOne) {
         std::vector<std::string>{"--log-level", "info", "traits", "--help"}}) {
     const CliRun help = runFieldrig(args, dir.path());
     EXPECT_EQ(help.exit_code, 0) << help.err;
-    std::string out;
-    for (const std::string& line : help.out_lines)
-      out += line + "\n";
+    const std::string out = readWholeFile(dir / "cli.out");
     EXPECT_NE(out.find("--cloud"), std::string::npos) << out;
     EXPECT_NE(out.find(light_footer), std::string::npos) << out;
   }
   const CliRun synth = runFieldrig({"traits", "synth", "--help"}, dir.path());
   EXPECT_EQ(synth.exit_code, 0) << synth.err;
-  std::string synth_out;
-  for (const std::string& line : synth.out_lines)
-    synth_out += line + "\n";
+  const std::string synth_out = readWholeFile(dir / "cli.out");
   EXPECT_NE(synth_out.find("--no-plants"), std::string::npos) << synth_out;
   EXPECT_EQ(synth_out.find(light_footer), std::string::npos) << synth_out;
 

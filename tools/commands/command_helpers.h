@@ -19,6 +19,7 @@
 
 #include "commands/commands.h"
 #include "fieldrig/core/exception_message.h"
+#include "fieldrig/core/logging.h"
 
 namespace fieldrig::tools {
 
@@ -105,6 +106,14 @@ inline std::string commandName(const CLI::App& app, const std::string& program) 
     name += " " + at->get_name();
   }
   return name;
+}
+
+// The top-level --log-level option of every fieldrig program; logging is set up once the command
+// line is parsed.
+inline void addLogLevelOption(CLI::App& app, std::string& log_level) {
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
+      ->capture_default_str();
+  app.parse_complete_callback([&log_level] { core::setupLogging(log_level); });
 }
 
 // main(): parses the command line, whose subcommand callbacks run the command and set
