@@ -17,19 +17,19 @@ namespace {
 
 using namespace std::chrono_literals;
 
-constexpr std::uint32_t kWidth = 16;
-constexpr std::uint32_t kHeight = 4;
+constexpr std::uint32_t kFaultFrameWidth = 16;
+constexpr std::uint32_t kFaultFrameHeight = 4;
 
 FaultInjector patternWith(const FaultOptions& faults) {
-  return FaultInjector(std::make_unique<TestPatternSource>(kWidth), faults);
+  return FaultInjector(std::make_unique<TestPatternSource>(kFaultFrameWidth), faults);
 }
 
-SimTrigger triggerNumber(std::uint64_t id, core::SteadyTime issued = core::SteadyTime{1s}) {
+SimTrigger faultTrigger(std::uint64_t id, core::SteadyTime issued = core::SteadyTime{1s}) {
   return {id, id - 1, issued};
 }
 
 core::Frame frameFor(const SimTrigger& trigger) {
-  return stampedFrame(trigger, 2, kWidth, kHeight, core::PixelFormat::kMono8);
+  return stampedFrame(trigger, 2, kFaultFrameWidth, kFaultFrameHeight, core::PixelFormat::kMono8);
 }
 
 // The frame of one trigger through the pattern with `faults`, its buffer from `pool`; nullopt
@@ -45,9 +45,9 @@ std::optional<core::Frame> fillOne(const FaultOptions& faults, const SimTrigger&
 
 bool isPattern(const core::Frame& frame) {
   const std::uint8_t* pixels = frame.buffer.bytes().data();
-  for (std::uint32_t y = 0; y < kHeight; ++y) {
-    for (std::uint32_t x = 0; x < kWidth; ++x) {
-      if (pixels[y * kWidth + x] !=
+  for (std::uint32_t y = 0; y < kFaultFrameHeight; ++y) {
+    for (std::uint32_t x = 0; x < kFaultFrameWidth; ++x) {
+      if (pixels[y * kFaultFrameWidth + x] !=
           TestPatternSource::patternAt(frame.metadata.camera, frame.metadata.trigger_id, x, y))
         return false;
     }
@@ -56,8 +56,9 @@ bool isPattern(const core::Frame& frame) {
 }
 
 TEST(FaultInjectorTest, WithoutFaultsTheSourcesFrameComesThroughAsItIs) {
-  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
-  const auto frame = fillOne({}, triggerNumber(6), *pool);
+  const auto pool =
+      core::FramePool::create(1, std::size_t{kFaultFrameWidth} * kFaultFrameHeight).value();
+  const auto frame = fillOne({}, faultTrigger(6), *pool);
   ASSERT_TRUE(frame && frame->buffer);
   EXPECT_EQ(frame->metadata.status, core::FrameStatus::kOk);
   EXPECT_EQ(frame->metadata.device_timestamp_ns, 1'000'000'000);
@@ -68,11 +69,12 @@ TEST(FaultInjectorTest, DropEveryNDeliversNothingForIdsDivisibleByNAndTakesNoBuf
   FaultOptions faults;
   faults.drop_every = 3;
   FaultInjector source = patternWith(faults);
-  const auto pool = core::FramePool::create(8, std::size_t{kWidth} * kHeight).value();
+  const auto pool =
+      core::FramePool::create(8, std::size_t{kFaultFrameWidth} * kFaultFrameHeight).value();
   std::vector<core::Frame> delivered;
   for (std::uint64_t id = 1; id <= 7; ++id) {
-    core::Frame frame = frameFor(triggerNumber(id));
-    const bool filled = source.fill(triggerNumber(id), *pool, frame);
+    core::Frame frame = frameFor(faultTrigger(id));
+    const bool filled = source.fill(faultTrigger(id), *pool, frame);
     EXPECT_EQ(filled, id % 3 != 0) << "trigger " << id;
     if (filled)
       delivered.push_back(std::move(frame));
@@ -87,10 +89,11 @@ TEST(FaultInjectorTest, CorruptEveryNMarksThoseFramesAndKeepsTheirPixels) {
   FaultOptions faults;
   faults.corrupt_every = 2;
   FaultInjector source = patternWith(faults);
-  const auto pool = core::FramePool::create(4, std::size_t{kWidth} * kHeight).value();
+  const auto pool =
+      core::FramePool::create(4, std::size_t{kFaultFrameWidth} * kFaultFrameHeight).value();
   for (std::uint64_t id = 1; id <= 4; ++id) {
-    core::Frame frame = frameFor(triggerNumber(id));
-    ASSERT_TRUE(source.fill(triggerNumber(id), *pool, frame));
+    core::Frame frame = frameFor(faultTrigger(id));
+    ASSERT_TRUE(source.fill(faultTrigger(id), *pool, frame));
     ASSERT_TRUE(frame.buffer);
     EXPECT_EQ(frame.metadata.status,
               id % 2 == 0 ? core::FrameStatus::kCorrupt : core::FrameStatus::kOk)
@@ -102,9 +105,10 @@ TEST(FaultInjectorTest, CorruptEveryNMarksThoseFramesAndKeepsTheirPixels) {
 TEST(FaultInjectorTest, AFrameDroppedForWantOfABufferStaysDroppedNotCorrupt) {
   FaultOptions faults;
   faults.corrupt_every = 1;
-  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
+  const auto pool =
+      core::FramePool::create(1, std::size_t{kFaultFrameWidth} * kFaultFrameHeight).value();
   const core::FrameBuffer held = pool->acquire();
-  const auto frame = fillOne(faults, triggerNumber(5), *pool);
+  const auto frame = fillOne(faults, faultTrigger(5), *pool);
   ASSERT_TRUE(frame);
   EXPECT_FALSE(frame->buffer);
   EXPECT_EQ(frame->metadata.status, core::FrameStatus::kDropped);
@@ -113,8 +117,9 @@ TEST(FaultInjectorTest, AFrameDroppedForWantOfABufferStaysDroppedNotCorrupt) {
 TEST(FaultInjectorTest, ClockOffsetShiftsTheDeviceTimestampExactly) {
   FaultOptions faults;
   faults.clock_offset = 250us;
-  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
-  const auto frame = fillOne(faults, triggerNumber(1), *pool);
+  const auto pool =
+      core::FramePool::create(1, std::size_t{kFaultFrameWidth} * kFaultFrameHeight).value();
+  const auto frame = fillOne(faults, faultTrigger(1), *pool);
   ASSERT_TRUE(frame);
   EXPECT_EQ(frame->metadata.device_timestamp_ns, 1'000'000'000 + 250'000);
   EXPECT_EQ(frame->metadata.status, core::FrameStatus::kOk);
@@ -123,9 +128,10 @@ TEST(FaultInjectorTest, ClockOffsetShiftsTheDeviceTimestampExactly) {
 TEST(FaultInjectorTest, DelayHoldsTheFrameUntilItsTriggerPlusTheDelay) {
   FaultOptions faults;
   faults.delay = 30ms;
-  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
+  const auto pool =
+      core::FramePool::create(1, std::size_t{kFaultFrameWidth} * kFaultFrameHeight).value();
   const core::SteadyTime issued = std::chrono::steady_clock::now();
-  const auto frame = fillOne(faults, triggerNumber(1, issued), *pool);
+  const auto frame = fillOne(faults, faultTrigger(1, issued), *pool);
   EXPECT_GE(std::chrono::steady_clock::now(), issued + 30ms);
   ASSERT_TRUE(frame);
   EXPECT_TRUE(isPattern(*frame));

@@ -18,12 +18,12 @@ using namespace std::chrono_literals;
 using recording::FrameStatus;
 using testing_support::ScopedTempDir;
 
-constexpr int kWidth = 4;
-constexpr int kHeight = 2;
+constexpr int kReplayWidth = 4;
+constexpr int kReplayHeight = 2;
 constexpr std::int64_t kIssuedNs = 1'000'000'000;  // every trigger here is issued at 1 s
 
 std::vector<std::uint8_t> pixelsFrom(std::uint8_t first) {
-  std::vector<std::uint8_t> pixels(kWidth * kHeight);
+  std::vector<std::uint8_t> pixels(kReplayWidth * kReplayHeight);
   std::iota(pixels.begin(), pixels.end(), first);
   return pixels;
 }
@@ -33,8 +33,8 @@ recording::FrameView view(int camera, FrameStatus status, std::int64_t device_ti
   recording::FrameView frame;
   frame.camera_index = camera;
   frame.camera_name = camera == 0 ? "bottom_left" : "bottom_right";
-  frame.width = kWidth;
-  frame.height = kHeight;
+  frame.width = kReplayWidth;
+  frame.height = kReplayHeight;
   frame.pixel_format = core::PixelFormat::kMono8;
   frame.pixels = pixels;
   frame.device_timestamp_ns = device_timestamp_ns;
@@ -66,11 +66,11 @@ std::filesystem::path writeSession(const std::filesystem::path& dir) {
   return session;
 }
 
-drivers::CameraConfig cameraConfig(const std::string& id, int width = kWidth) {
+drivers::CameraConfig cameraConfig(const std::string& id, int width = kReplayWidth) {
   drivers::CameraConfig config;
   config.id = id;
   config.width = static_cast<std::uint32_t>(width);
-  config.height = kHeight;
+  config.height = kReplayHeight;
   config.format = core::PixelFormat::kBayerRG8;  // the recorded Mono8 must win
   return config;
 }
@@ -86,10 +86,11 @@ Served serve(SessionReplaySource& source, core::FramePool& pool, std::uint32_t c
              std::uint64_t since_first) {
   const SimTrigger trigger{500 + since_first, since_first, core::SteadyTime{1s}};
   Served served;
-  served.frame = stampedFrame(trigger, camera, kWidth, kHeight, core::PixelFormat::kBayerRG8);
+  served.frame =
+      stampedFrame(trigger, camera, kReplayWidth, kReplayHeight, core::PixelFormat::kBayerRG8);
   served.delivered = source.fill(trigger, pool, served.frame);
   if (served.frame.buffer) {
-    const auto bytes = served.frame.buffer.bytes().first(std::size_t{kWidth} * kHeight);
+    const auto bytes = served.frame.buffer.bytes().first(std::size_t{kReplayWidth} * kReplayHeight);
     served.pixels.assign(bytes.begin(), bytes.end());
   }
   return served;
@@ -106,7 +107,7 @@ TEST_P(SessionReplaySourceTest, ServesTheRecordedSetsInOrderAndWrapsAround) {
   ASSERT_TRUE(camera1.ok()) << camera1.error().message;
   EXPECT_EQ((*camera0)->preloaded(), GetParam() > 0);
   EXPECT_EQ((*camera1)->preloaded(), GetParam() > 0);
-  const auto pool = core::FramePool::create(16, std::size_t{kWidth} * kHeight).value();
+  const auto pool = core::FramePool::create(16, std::size_t{kReplayWidth} * kReplayHeight).value();
 
   for (std::uint64_t lap = 0; lap < 2; ++lap) {
     SCOPED_TRACE("lap " + std::to_string(lap));
@@ -150,7 +151,7 @@ TEST(SessionReplaySourceErrorsTest, ADryPoolGivesADroppedFrame) {
   const ScopedTempDir dir("replay_source_dry");
   auto source = SessionReplaySource::open(cameraConfig("0"), 0, writeSession(dir.path()), 64);
   ASSERT_TRUE(source.ok()) << source.error().message;
-  const auto pool = core::FramePool::create(1, std::size_t{kWidth} * kHeight).value();
+  const auto pool = core::FramePool::create(1, std::size_t{kReplayWidth} * kReplayHeight).value();
   const core::FrameBuffer held = pool->acquire();
   const Served s = serve(**source, *pool, 0, 0);
   ASSERT_TRUE(s.delivered);
@@ -166,11 +167,11 @@ TEST(SessionReplaySourceErrorsTest, ADamagedFileIsAnErrorAtOpenOrACorruptFrameWh
   const auto file = session / recording::frameFileName(0, 1, "bottom_right");
   ASSERT_TRUE(std::filesystem::remove(file));
 
-  const auto pool = core::FramePool::create(2, std::size_t{kWidth} * kHeight).value();
+  const auto pool = core::FramePool::create(2, std::size_t{kReplayWidth} * kReplayHeight).value();
   const Served s = serve(**streamed, *pool, 1, 0);
   ASSERT_TRUE(s.delivered);
   EXPECT_EQ(s.frame.metadata.status, core::FrameStatus::kCorrupt);
-  EXPECT_EQ(s.pixels, std::vector<std::uint8_t>(kWidth * kHeight, 0));
+  EXPECT_EQ(s.pixels, std::vector<std::uint8_t>(kReplayWidth * kReplayHeight, 0));
 
   const auto preloaded = SessionReplaySource::open(cameraConfig("1"), 1, session, 64);
   ASSERT_FALSE(preloaded.ok());

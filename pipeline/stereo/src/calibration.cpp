@@ -98,9 +98,8 @@ core::Result<void> checkCameraMatrix(const cv::Mat& m, const std::string& field,
   const double margin_y = kPrincipalPointMargin * image_size.height;
   if (cx < -margin_x || cx > image_size.width + margin_x || cy < -margin_y ||
       cy > image_size.height + margin_y) {
-    return fieldError(field, principal_point + " lies outside the " +
-                                 std::to_string(image_size.width) + "x" +
-                                 std::to_string(image_size.height) + " image");
+    return fieldError(field,
+                      principal_point + " lies outside the " + sizeText(image_size) + " image");
   }
   return {};
 }
@@ -466,6 +465,10 @@ core::Result<std::filesystem::path> saveStereoCalibration(const StereoCalibratio
       return Error{std::move(failed)};
   }
   return directory;
+}
+
+std::string sizeText(cv::Size size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
 
 }  // namespace fieldrig::stereo

@@ -12,10 +12,6 @@
 namespace fieldrig::stereo {
 namespace {
 
-std::string sizeText(cv::Size size) {
-  return std::to_string(size.width) + "x" + std::to_string(size.height);
-}
-
 double median(std::vector<double>& values) {
   if (values.empty())
     return 0;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "fieldrig/core/result.h"
 
@@ -34,6 +35,9 @@ struct StereoCalibration {
 // right one `baseline_m` along the left one's x, rectified with stereoRectify: the calibration of
 // rendered scenes and synthetic rigs.
 StereoCalibration idealStereoCalibration(double focal_px, cv::Size image_size, double baseline_m);
+
+// "WIDTHxHEIGHT", as error messages about image sizes print it.
+std::string sizeText(cv::Size size);
 
 // Whether the values are usable, not only well-formed: OpenCV rectifies and reprojects with any
 // finite matrix without complaint, so a singular camera matrix or a zeroed rotation would turn
