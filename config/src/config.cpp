@@ -322,6 +322,7 @@ void readCloud(const Value& section, cloud::CloudOptions& o) {
                            {"min_depth_m", nonNegative(o.min_depth_m)},
                            {"max_depth_m", positive(o.max_depth_m)},
                            {"edge_max_jump_px", nonNegative(o.edge_max_jump_px)},
+                           {"edge_keep_near_side", flag(o.edge_keep_near_side)},
                        });
   if (!(o.min_depth_m < o.max_depth_m)) {
     const Value& at = entries.contains("min_depth_m") ? entries.at("min_depth_m")

@@ -103,6 +103,7 @@ void expectSame(const cloud::CloudOptions& actual, const cloud::CloudOptions& ex
   EXPECT_FIELD(min_depth_m);
   EXPECT_FIELD(max_depth_m);
   EXPECT_FIELD(edge_max_jump_px);
+  EXPECT_FIELD(edge_keep_near_side);
   expectSame(actual.matcher, expected.matcher);
 }
 
@@ -642,7 +643,8 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
       "pipeline:\n"
       "  enabled: false\n"
       "  queue_sets: 3\n"
-      "  cloud: {scale: 0.25, min_depth_m: 0.3, max_depth_m: 2.5, edge_max_jump_px: 0}\n"
+      "  cloud: {scale: 0.25, min_depth_m: 0.3, max_depth_m: 2.5, edge_max_jump_px: 0,\n"
+      "          edge_keep_near_side: true}\n"
       "  matcher:\n"
       "    num_disparities: 64\n"
       "    min_disparity: -8\n"
@@ -721,6 +723,7 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
   cloud_options.min_depth_m = 0.3;
   cloud_options.max_depth_m = 2.5;
   cloud_options.edge_max_jump_px = 0;
+  cloud_options.edge_keep_near_side = true;
   cloud_options.matcher = matcher;
   expectSame(c.pipeline.cloud, cloud_options);
   EXPECT_FALSE(c.outputs.csv);

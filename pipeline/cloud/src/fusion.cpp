@@ -88,17 +88,22 @@ void measureCoverage(const cv::Mat& disparity, HeadStatus& status) {
       static_cast<double>(cv::countNonZero(column_max)) / static_cast<double>(disparity.cols);
 }
 
-std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump) {
+std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump, bool keep_near_side) {
   CV_Assert(disparity.type() == CV_32F);
   // Neighbourhood maximum and minimum by grey dilation and erosion; invalid pixels must not
   // count, so they are below every disparity for the maximum and above for the minimum.
   const cv::Mat invalid = ~(disparity > 0);
-  cv::Mat for_min = disparity.clone();
-  for_min.setTo(std::numeric_limits<float>::max(), invalid);
-  cv::Mat highest, lowest;
+  cv::Mat highest;
   const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
   cv::dilate(disparity, highest, kernel);
-  cv::erode(for_min, lowest, kernel);
+  cv::Mat lowest;
+  if (keep_near_side) {
+    lowest = disparity;  // the far-side test compares with the pixel itself
+  } else {
+    cv::Mat for_min = disparity.clone();
+    for_min.setTo(std::numeric_limits<float>::max(), invalid);
+    cv::erode(for_min, lowest, kernel);
+  }
   const cv::Mat edge = (highest - lowest > max_jump) & ~invalid;
   const auto dropped = static_cast<std::size_t>(cv::countNonZero(edge));
   disparity.setTo(stereo::kInvalidDisparity, edge);
@@ -175,7 +180,8 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
         }
       }
       if (options_.edge_max_jump_px > 0)
-        status.edge_pixels = dropDepthEdges(output->disparity, options_.edge_max_jump_px);
+        status.edge_pixels = dropDepthEdges(output->disparity, options_.edge_max_jump_px,
+                                            options_.edge_keep_near_side);
       if (truth_disparity) {
         status.cloud_score = heads_[i].truthDepth().scoreCloud(
             output->disparity, *truth_disparity, options_.min_depth_m, options_.max_depth_m);

@@ -164,6 +164,26 @@ TEST(DepthEdges, BlendedPixelsAtAStepGoAndSlopesStay) {
   EXPECT_GE(dropped, 5U * 9U);
 }
 
+TEST(DepthEdges, KeepingTheNearSideKeepsTheLeafsEdgeAndDropsTheBlend) {
+  // A leaf at 60 px (columns < 18), SGBM's blend in columns 18-21, the background at 10 px beyond.
+  cv::Mat disparity(10, 40, CV_32F);
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 0; x < 40; ++x)
+      disparity.at<float>(y, x) = x < 18 ? 60.0F : (x < 22 ? 60.0F - 12.5F * (x - 17) : 10.0F);
+  }
+  cv::Mat both_sides = disparity.clone();
+  const std::size_t dropped = dropDepthEdges(disparity, 2.0, /*keep_near_side=*/true);
+  dropDepthEdges(both_sides, 2.0);
+  for (int y = 0; y < 10; ++y) {
+    EXPECT_EQ(disparity.at<float>(y, 17), 60.0F) << "the leaf's own edge pixel stays, row " << y;
+    EXPECT_EQ(both_sides.at<float>(y, 17), stereo::kInvalidDisparity) << "row " << y;
+    for (int x = 18; x <= 21; ++x)
+      EXPECT_EQ(disparity.at<float>(y, x), stereo::kInvalidDisparity) << x << "," << y;
+    EXPECT_EQ(disparity.at<float>(y, 22), 10.0F) << "the background beyond the blend, row " << y;
+  }
+  EXPECT_EQ(dropped, 4U * 10U);
+}
+
 TEST(Rig, SaveLoadRoundTrip) {
   ScopedTempDir dir("cloud_rig_round_trip");
   RigCalibration rig = syntheticRig();

@@ -19,7 +19,8 @@
 //               options {driver-specific key: value, given to every camera}
 //   calibration: the calibration folder (rig.yml + one folder per head)
 //   recording:  dir, fsync (none|per_set|per_frame)
-//   pipeline:   enabled, queue_sets, cloud {scale, min_depth_m, max_depth_m, edge_max_jump_px},
+//   pipeline:   enabled, queue_sets, cloud {scale, min_depth_m, max_depth_m, edge_max_jump_px,
+//               edge_keep_near_side},
 //               matcher {…MatcherOptions; mode sgbm|hh|sgbm_3way|hh4},
 //               traits {…TraitsOptions; outlier_method statistical|voxel_neighbours,
 //               area_method depth_map|paper|none, camera_to_plot [[3 numbers] × 3]}

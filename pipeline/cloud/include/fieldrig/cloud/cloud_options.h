@@ -29,6 +29,10 @@ struct CloudOptions {
   // disparity — are not reprojected: SGBM blends foreground and background there, and the
   // blend lands as "flying" points between a leaf and what is behind it. 0 keeps them.
   double edge_max_jump_px = 2.0;
+  // Drop only the far side of each such jump (a pixel with a neighbour more than the jump nearer):
+  // the blend and the background beside a leaf go, the leaf's own edge pixels stay. Off: both
+  // sides go, which also removes the edges of every leaf, its tips included.
+  bool edge_keep_near_side = false;
   DepthSource depth_source = DepthSource::kStereo;
 };
 

@@ -72,9 +72,10 @@ std::size_t appendReprojected(const cv::Mat& disparity, const cv::Mat& left_bgr,
 void measureCoverage(const cv::Mat& disparity, HeadStatus& status);
 
 // Marks as invalid (stereo::kInvalidDisparity) every pixel of `disparity` (CV_32F) whose valid
-// 3×3 neighbours, itself included, differ by more than `max_jump` pixels of disparity. Returns how
-// many pixels it invalidated.
-std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump);
+// 3×3 neighbours, itself included, differ by more than `max_jump` pixels of disparity; with
+// `keep_near_side`, only those with a neighbour more than `max_jump` above their own disparity
+// (the far side of the jump, and the blend between). Returns how many pixels it invalidated.
+std::size_t dropDepthEdges(cv::Mat& disparity, double max_jump, bool keep_near_side = false);
 
 // Thread contract: thread-compatible; one instance per thread.
 class CloudBuilder {
