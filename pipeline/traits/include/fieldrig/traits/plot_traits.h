@@ -66,8 +66,9 @@ struct TraitsOptions {
   double row_length_m = 1.5;
   // Only plant points within ±row_length_m / 2 of the plot's location (y = 0) are the plot's.
   // Off: on the 24-plot rendered field (bench/mesh_field_bench.py, seed 11) it made every trait
-  // worse against the mesh truth (width 6.6 → 8.3 cm mean abs, VVI 5.7 → 7.8 %), since the plot's
-  // own leaves reach past its ends.
+  // worse against the mesh truth (width 6.6 → 8.3 cm mean abs, VVI 5.7 → 7.8 %). The truth counts
+  // all of the plot's own plants; why cropping to the row loses more than the neighbours add is
+  // not yet known.
   bool crop_to_row_length = false;
   double intra_row_spacing_m = 0.15;
   int slices = 0;
