@@ -41,6 +41,7 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
           {"outlier_mean_k", integer(o.outlier_mean_k, 1)},
           {"outlier_stddev_mul", nonNegative(o.outlier_stddev_mul)},
           {"outlier_min_neighbours", integer(o.outlier_min_neighbours, 0, 26)},
+          {"min_piece_voxels", integer(o.min_piece_voxels, 0, 1000000)},
           {"crop_z_max_m", positive(o.crop_z_max_m)},
           {"crop_z_min_m", nonNegative(o.crop_z_min_m)},
           {"max_abs_coordinate_m", positive(o.max_abs_coordinate_m)},
@@ -59,6 +60,7 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
           {"crop_to_row_length", flag(o.crop_to_row_length)},
           {"intra_row_spacing_m", positive(o.intra_row_spacing_m)},
           {"slices", integer(o.slices, 0)},
+          {"slice_width_quantile", numberIn(o.slice_width_quantile, 0, 0.25)},
           {"min_row_extent_m", nonNegative(o.min_row_extent_m)},
           {"min_plant_points",
            [&](const Value& v) {

@@ -117,6 +117,7 @@ void expectSame(const traits::TraitsOptions& actual, const traits::TraitsOptions
   EXPECT_FIELD(outlier_mean_k);
   EXPECT_FIELD(outlier_stddev_mul);
   EXPECT_FIELD(outlier_min_neighbours);
+  EXPECT_FIELD(min_piece_voxels);
   EXPECT_FIELD(crop_z_max_m);
   EXPECT_FIELD(crop_z_min_m);
   EXPECT_FIELD(max_abs_coordinate_m);
@@ -135,6 +136,7 @@ void expectSame(const traits::TraitsOptions& actual, const traits::TraitsOptions
   EXPECT_FIELD(crop_to_row_length);
   EXPECT_FIELD(intra_row_spacing_m);
   EXPECT_FIELD(slices);
+  EXPECT_FIELD(slice_width_quantile);
   EXPECT_FIELD(min_row_extent_m);
   EXPECT_FIELD(min_plant_points);
   EXPECT_FIELD(alpha);
@@ -394,6 +396,8 @@ TEST_F(ConfigErrors, NumbersBeyondTheirCeilingOrNotFiniteAreRefusedWithTheRange)
 // The traits options' own ranges (TraitsOptions::validate) reach the configuration with the key
 // and line of the value.
 TEST_F(ConfigErrors, TraitsOptionsOutsideTheirRangeNameTheKey) {
+  expectError("pipeline:\n  traits:\n    slice_width_quantile: 0.5\n", 3,
+              "pipeline.traits.slice_width_quantile", "0.5 is out of range [0, 0.25]");
   expectError("pipeline:\n  traits:\n    slices: 2000000000\n", 3, "pipeline.traits.slices",
               "2000000000 is out of range [0, 1000]");
   expectError("pipeline:\n  traits:\n    depth_map_cell_m: 1e-9\n", 3,
@@ -819,6 +823,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
                                   "outlier_mean_k: 40\n"
                                   "outlier_stddev_mul: 2\n"
                                   "outlier_min_neighbours: 4\n"
+                                  "min_piece_voxels: 40\n"
                                   "crop_z_max_m: 2.2\n"
                                   "crop_z_min_m: 0.1\n"
                                   "max_abs_coordinate_m: 500\n"
@@ -835,6 +840,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
                                   "row_length_m: 3\n"
                                   "intra_row_spacing_m: 0.1\n"
                                   "slices: 30\n"
+                                  "slice_width_quantile: 0.03\n"
                                   "min_row_extent_m: 0.1\n"
                                   "min_plant_points: 80\n"
                                   "alpha: 0.35\n"
@@ -856,6 +862,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
   expected.outlier_mean_k = 40;
   expected.outlier_stddev_mul = 2;
   expected.outlier_min_neighbours = 4;
+  expected.min_piece_voxels = 40;
   expected.crop_z_max_m = 2.2;
   expected.crop_z_min_m = 0.1;
   expected.max_abs_coordinate_m = 500;
@@ -872,6 +879,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
   expected.row_length_m = 3;
   expected.intra_row_spacing_m = 0.1;
   expected.slices = 30;
+  expected.slice_width_quantile = 0.03;
   expected.min_row_extent_m = 0.1;
   expected.min_plant_points = 80;
   expected.alpha = 0.35;

@@ -86,6 +86,7 @@ nlohmann::ordered_json traitsToJson(const TraitsResult& r, bool with_slices) {
                   {"points_background", q.points_background},
                   {"points_after_voxel", q.points_after_voxel},
                   {"points_outliers", q.points_outliers},
+                  {"points_small_pieces", q.points_small_pieces},
                   {"points_ground", q.points_ground},
                   {"points_ground_tilted", q.points_ground_tilted},
                   {"points_plants", q.points_plants},

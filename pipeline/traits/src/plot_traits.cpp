@@ -112,6 +112,7 @@ std::optional<OptionsProblem> TraitsOptions::validate() const {
       outOfRange("outlier_mean_k", outlier_mean_k, 1, 1000),
       outOfRange("outlier_stddev_mul", outlier_stddev_mul, 0, 100),
       outOfRange("outlier_min_neighbours", outlier_min_neighbours, 0, 26),
+      outOfRange("min_piece_voxels", min_piece_voxels, 0, 1000000),
       outOfRange("crop_z_max_m", crop_z_max_m, 0.01, 100),
       outOfRange("crop_z_min_m", crop_z_min_m, 0, 100),
       outOfRange("max_abs_coordinate_m", max_abs_coordinate_m, 1, 1e6),
@@ -130,6 +131,7 @@ std::optional<OptionsProblem> TraitsOptions::validate() const {
       outOfRange("intra_row_spacing_m", intra_row_spacing_m, 0.001, 10),
       // sliceCount's own ceiling for a count derived from the row.
       outOfRange("slices", slices, 0, 1000),
+      outOfRange("slice_width_quantile", slice_width_quantile, 0, 0.25),
       outOfRange("min_row_extent_m", min_row_extent_m, 0, 100),
       outOfRange("min_plant_points", static_cast<double>(min_plant_points), 0, 1e9),
       outOfRange("alpha", alpha, 0, 1, true),
@@ -274,12 +276,34 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& all_plant
     return static_cast<std::size_t>(
         std::clamp(static_cast<int>((y - result.y_min) / slice_length), 0, n - 1));
   };
+  std::vector<std::vector<float>> slice_depths;  // for slice_width_quantile
+  if (options.slice_width_quantile > 0.0)
+    slice_depths.resize(static_cast<std::size_t>(n));
   for (const Eigen::Vector3f& p : plant_points) {
-    SliceStats& s = result.slices[sliceOf(p.y())];
+    const std::size_t index = sliceOf(p.y());
+    SliceStats& s = result.slices[index];
     ++s.points;
     s.x_max = std::max(s.x_max, static_cast<double>(p.x()));
     s.z_min = std::min(s.z_min, static_cast<double>(p.z()));
     s.z_max = std::max(s.z_max, static_cast<double>(p.z()));
+    if (!slice_depths.empty())
+      slice_depths[index].push_back(p.z());
+  }
+  for (std::size_t i = 0; i < slice_depths.size(); ++i) {
+    std::vector<float>& depths = slice_depths[i];
+    if (depths.empty())
+      continue;
+    // The near edge the same number of voxels in from the nearest as the far edge from the
+    // furthest.
+    const auto k = static_cast<std::size_t>(options.slice_width_quantile *
+                                            static_cast<double>(depths.size() - 1));
+    const auto at = [&](std::size_t rank) {
+      std::nth_element(depths.begin(), depths.begin() + static_cast<std::ptrdiff_t>(rank),
+                       depths.end());
+      return static_cast<double>(depths[rank]);
+    };
+    result.slices[i].z_min = at(k);
+    result.slices[i].z_max = at(depths.size() - 1 - k);
   }
   std::vector<std::pair<double, double>> x_max, z_min, z_max;
   for (SliceStats& s : result.slices) {
@@ -446,6 +470,9 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
     cloud = removeSparseOutliers(cloud, options.voxel_leaf_m, options.outlier_min_neighbours,
                                  q.points_outliers);
   }
+  cloud =
+      removeSmallPieces(cloud, options.voxel_leaf_m,
+                        static_cast<std::size_t>(options.min_piece_voxels), q.points_small_pieces);
   result.timings.filter_ms = core::millisecondsSince(filter_start);
   if (cloud.size() < options.min_plant_points)
     return failed(std::move(result), TraitsStatus::kNoPlants,
@@ -546,6 +573,7 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
   traits.quality.points_background = q.points_background;
   traits.quality.points_after_voxel = q.points_after_voxel;
   traits.quality.points_outliers = q.points_outliers;
+  traits.quality.points_small_pieces = q.points_small_pieces;
   traits.quality.points_ground = q.points_ground;
   traits.quality.points_ground_tilted = q.points_ground_tilted;
   traits.quality.icp_fitness_coarse = q.icp_fitness_coarse;

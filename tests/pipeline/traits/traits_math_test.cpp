@@ -1,5 +1,5 @@
 // The trait math on tiny hand-made geometry: weighted median, slice count, areas of surfaces of
-// known size, outliers on the voxel grid, the options file.
+// known size, outliers and small pieces on the voxel grid, the options file.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -44,6 +44,46 @@ TEST(WeightedMedian, IgnoresASingleTallSlice) {
   const double median = weightedMedian(slices);
   EXPECT_GE(median, 2.0);
   EXPECT_LE(median, 2.19);
+}
+
+// A 1 m tall, 1 m long, 0.2 m deep block of plant points 1.0-1.2 m from the camera, with in every
+// slice a few mismatch-like voxels 10 cm nearer and a few 30 cm above the top.
+Points blockWithStrayVoxels() {
+  Points points;
+  const float step = 0.02F;
+  for (int i = 0; i <= 50; ++i)
+    for (int j = 0; j <= 50; ++j)
+      for (int k = 0; k <= 10; ++k)
+        points.emplace_back(i * step, -0.5F + j * step, 1.0F + k * step);
+  for (int j = 0; j < 50; j += 2) {
+    for (int k = 0; k < 3; ++k) {
+      points.emplace_back(0.5F, -0.49F + j * step, 0.9F + k * 0.01F);  // near the camera
+      points.emplace_back(1.3F - k * 0.01F, -0.49F + j * step, 1.1F);  // above the top
+    }
+  }
+  return points;
+}
+
+TEST(SliceExtent, TheExtremePointLetsAFewStrayVoxelsSetTheWidth) {
+  const TraitsResult result = traitsFromPlantPoints(blockWithStrayVoxels(), 0.0, TraitsOptions{});
+  ASSERT_TRUE(result.heightWidthValid()) << result.message;
+  EXPECT_NEAR(result.width_m, 0.30, 1e-3);  // 0.9 to 1.2
+  EXPECT_NEAR(result.height_m, 1.30, 1e-3);
+}
+
+TEST(SliceExtent, AWidthQuantileIgnoresTheStrayVoxelsAndLeavesTheTop) {
+  TraitsOptions options;
+  options.slice_width_quantile = 0.02;
+  const TraitsResult result = traitsFromPlantPoints(blockWithStrayVoxels(), 0.0, options);
+  ASSERT_TRUE(result.heightWidthValid()) << result.message;
+  // The block's own depth, less at most one 2 cm layer on either side.
+  EXPECT_NEAR(result.width_m, 0.20, 0.021);
+  EXPECT_LE(result.width_m, 0.20 + 1e-6);
+  for (const SliceStats& slice : result.slices) {
+    EXPECT_GE(slice.z_min, 1.0 - 1e-6);
+    EXPECT_LE(slice.z_max, 1.2 + 1e-6);
+  }
+  EXPECT_NEAR(result.height_m, 1.30, 1e-3);  // the top is still the slices' highest point
 }
 
 TEST(SliceCount, FollowsEquation15) {
@@ -132,6 +172,38 @@ TEST(SparseOutliers, DropIsolatedVoxelsOnly) {
   const Points kept = removeSparseOutliers(cloud, 0.01, 2, removed);
   EXPECT_EQ(removed, 2U);
   EXPECT_EQ(kept.size(), surface);
+}
+
+TEST(SmallPieces, DropBlobsApartFromTheSurfaceAndKeepWhatTouchesIt) {
+  // A 30 x 30 cell surface at cell centres, a 3 x 3 x 2 blob 10 cm in front of it (dense enough
+  // to pass the neighbour count) and a 40-cell diagonal strand joined to the surface only through
+  // the corners of its cells (a thin leaf seen edge-on).
+  const float cell = 0.01F;
+  auto centre = [&](int i, int j, int k) {
+    return Eigen::Vector3f((i + 0.5F) * cell, (j + 0.5F) * cell, (k + 0.5F) * cell);
+  };
+  Points cloud;
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j)
+      cloud.push_back(centre(i, j, 100));
+  const std::size_t surface = cloud.size();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 2; ++k)
+        cloud.push_back(centre(10 + i, 10 + j, 90 + k));
+  for (int step = 1; step <= 40; ++step)
+    cloud.push_back(centre(29 + step, 29 + step, 100 - step));
+  std::size_t removed = 0;
+  const Points kept = removeSmallPieces(cloud, cell, 20, removed);
+  EXPECT_EQ(removed, 18U);  // the blob, all of it
+  EXPECT_EQ(kept.size(), surface + 40);
+  for (const Eigen::Vector3f& p : kept)
+    EXPECT_FALSE(p.z() < 0.95F && p.z() > 0.89F && p.x() < 0.14F) << p.transpose();
+  // 0 or 1 keeps everything; a piece exactly at the limit stays.
+  EXPECT_EQ(removeSmallPieces(cloud, cell, 0, removed).size(), cloud.size());
+  EXPECT_EQ(removed, 0U);
+  EXPECT_EQ(removeSmallPieces(cloud, cell, 18, removed).size(), cloud.size());
+  EXPECT_EQ(removeSmallPieces(cloud, cell, 19, removed).size(), surface + 40);
 }
 
 TEST(VoxelDownsample, ShiftedGridKeepsTheGeometry) {
