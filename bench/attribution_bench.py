@@ -26,7 +26,7 @@ error| > 2 px at matching resolution, of the matched ones) and the median depth 
 head's points in the fused cloud from (b) and (c). The last line is one JSON summary.
 
 Usage: bench/attribution_bench.py [BUILD_DIR] [--plots 8] [--rows 2] [--seed 11] [--out DIR]
-       [--process-args ARGS]
+       [--process-args ARGS] [--traits-config FILE]
 With --out the field and results stay in DIR and a field already there is reused (delete it to
 remake); without it they go to a temporary folder. Rendering takes ~5-10 s a plot on 2 cores.
 """
@@ -40,7 +40,7 @@ import subprocess
 import sys
 import tempfile
 
-from mesh_field_bench import add_field_arguments, read_truth, rendered_field
+from mesh_field_bench import add_field_arguments, read_truth, rendered_field, traits_config_args
 
 TRAITS = [("height_m", "height", "m"), ("width_m", "width", "m"), ("vvi", "VVI", ""),
           ("vai", "VAI", "")]
@@ -70,10 +70,11 @@ def read_results(path):
     return lines
 
 
-def process(fieldrig, field, out, extra, process_args):
+def process(fieldrig, field, out, extra, args):
     subprocess.run([fieldrig, "process", os.path.join(field, "source-session"), "--map",
                     os.path.join(field, "map.csv"), "--out", out, "--force"] + extra +
-                   shlex.split(process_args), check=True, stdout=subprocess.DEVNULL)
+                   traits_config_args(args) + shlex.split(args.process_args), check=True,
+                   stdout=subprocess.DEVNULL)
     return read_results(os.path.join(out, "plots.jsonl"))
 
 
@@ -86,7 +87,7 @@ def main():
     field = rendered_field(fieldrig, args, work)
     truth = read_truth(field)
     from_truth = process(fieldrig, field, os.path.join(work, "results-truth-depth"),
-                         ["--depth-source", "truth"], args.process_args)
+                         ["--depth-source", "truth"], args)
     from_truth_no_edges = None
     if "--config" not in args.process_args:
         shipped = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config",
@@ -102,9 +103,9 @@ def main():
         from_truth_no_edges = process(fieldrig, field,
                                       os.path.join(work, "results-truth-depth-no-edge-filter"),
                                       ["--depth-source", "truth", "--config", no_edges],
-                                      args.process_args)
+                                      args)
     from_stereo = process(fieldrig, field, os.path.join(work, "results-stereo"),
-                          ["--score-stereo"], args.process_args)
+                          ["--score-stereo"], args)
     for name, results in (("truth depth", from_truth), ("stereo", from_stereo)):
         for plot in results:
             if plot not in truth:

@@ -11,8 +11,8 @@ what both cameras of a head see (`stereo_view`: what stereo can place at all, wh
 truth counts what any camera sees), and per growth stage. The last line is one JSON summary.
 
 Usage: bench/mesh_field_bench.py [BUILD_DIR] [--plots 24] [--rows 2] [--seed 11] [--out DIR]
-       [--keep] [--process-args ARGS]
-With --out the field and results stay in DIR and a field already there is reused (delete it to
+       [--keep] [--process-args ARGS] [--traits-config FILE]
+--traits-config sets the trait definitions of both the truth and the processing. With --out the field and results stay in DIR and a field already there is reused (delete it to
 remake); without it they go to a temporary folder. Rendering takes ~5-10 s a plot on 2 cores.
 """
 import argparse
@@ -66,15 +66,38 @@ def add_field_arguments(parser, plots):
     parser.add_argument("--seed", type=int, default=11)
     parser.add_argument("--out")
     parser.add_argument("--process-args", default="")
+    parser.add_argument("--traits-config", default="",
+                        help="traits options (YAML) for the truth and the processing alike")
+
+
+def traits_config_args(args):
+    """`--traits-config FILE` for fieldrig simulate and process, or nothing."""
+    return ["--traits-config", args.traits_config] if args.traits_config else []
+
+
+def read_text(path):
+    if not path or not os.path.exists(path):
+        return ""
+    with open(path) as f:
+        return f.read()
 
 
 def rendered_field(fieldrig, args, work):
     """WORK/field, rendered by `fieldrig simulate` unless a field is already there."""
     field = os.path.join(work, "field")
+    # The truth's trait definitions are fixed when the field is rendered: a field is reused only
+    # with the traits options it was made with (a copy is kept beside it).
+    definitions = os.path.join(work, "field-traits-config.yaml")
+    wanted = read_text(args.traits_config)
     if not os.path.exists(os.path.join(field, "truth.jsonl")):
         subprocess.run([fieldrig, "simulate", "--plots", str(args.plots), "--rows", str(args.rows),
-                        "--seed", str(args.seed), "--stage", "early,mid,mature", "--out", field],
-                       check=True, stdout=subprocess.DEVNULL)
+                        "--seed", str(args.seed), "--stage", "early,mid,mature", "--out", field] +
+                       traits_config_args(args), check=True, stdout=subprocess.DEVNULL)
+        with open(definitions, "w") as f:
+            f.write(wanted)
+    elif read_text(definitions) != wanted:
+        sys.exit(f"{field}: its truth was made with other traits options ({definitions}) than "
+                 f"--traits-config '{args.traits_config}'; use another --out")
     return field
 
 
@@ -98,7 +121,8 @@ def main():
     results = os.path.join(work, "results")
     subprocess.run([fieldrig, "process", os.path.join(field, "source-session"), "--map",
                     os.path.join(field, "map.csv"), "--out", results, "--force"] +
-                   shlex.split(args.process_args), check=True, stdout=subprocess.DEVNULL)
+                   traits_config_args(args) + shlex.split(args.process_args), check=True,
+                   stdout=subprocess.DEVNULL)
     truth = read_truth(field)
     rows = []
     with open(os.path.join(results, "plots.jsonl")) as f:

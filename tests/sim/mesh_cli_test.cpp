@@ -1,10 +1,11 @@
 // `fieldrig sim plots` and `fieldrig simulate` with the mesh renderer, through the built binary:
 // --stage alone selects it and its summary says so; the frames get their truth maps unless
-// --no-truth-maps; options that do not fit the renderer are refused before anything is written,
-// naming the flag.
+// --no-truth-maps; --traits-config sets the truth's trait definitions; options that do not fit the
+// renderer or a bad traits file are refused before anything is written, naming the flag or file.
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -50,9 +51,34 @@ TEST(MeshCli, StageAloneSelectsTheMeshRendererAndTruthMapsCanBeLeftOut) {
       std::string::npos);
 }
 
+// --traits-config: the truth lines take the definitions the session will be processed with.
+TEST(MeshCli, TraitsConfigSetsTheDefinitionsOfTheTruth) {
+  ScopedTempDir dir("mesh_cli_truth_definitions");
+  const fs::path definitions = dir / "quantile.yaml";
+  { std::ofstream(definitions) << "slice_width_quantile: 0.05\n"; }
+  auto truthLine = [&](const std::string& name, const std::vector<std::string>& extra) {
+    std::vector<std::string> args = {"sim", "plots",   "--out", (dir / name).string(), "--count",
+                                     "1",   "--stage", "mid",   "--no-truth-maps"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto run = runFieldrig(args, dir.path());
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return nlohmann::json::parse(testing_support::readWholeFile(dir / name / "truth.jsonl"));
+  };
+  const auto extreme = truthLine("extreme", {});
+  const auto quantile = truthLine("quantile", {"--traits-config", definitions.string()});
+  // The same plot: the 5 % of each slice's voxels nearest and furthest no longer set its width.
+  EXPECT_EQ(quantile.at("visible_plant_area_m2"), extreme.at("visible_plant_area_m2"));
+  EXPECT_LT(quantile.at("width_m").get<double>(), extreme.at("width_m").get<double>() - 0.01);
+  EXPECT_EQ(quantile.at("height_m"), extreme.at("height_m"));  // the top is not a quantile
+  EXPECT_LT(quantile.at("stereo_view").at("width_m").get<double>(),
+            extreme.at("stereo_view").at("width_m").get<double>());
+}
+
 TEST(MeshCli, OptionsThatDoNotFitTheRendererAreRefusedBeforeAnythingIsWritten) {
   ScopedTempDir dir("mesh_cli_refusals");
   const std::string out = (dir / "out").string();
+  const fs::path bad_traits = dir / "bad-traits.yaml";
+  { std::ofstream(bad_traits) << "slice_width_quantile: 0.4\n"; }
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"sim", "plots", "--out", out, "--stage", "late"}, "--stage"},
       {{"sim", "plots", "--out", out, "--renderer", "raster"}, "--renderer"},
@@ -63,6 +89,10 @@ TEST(MeshCli, OptionsThatDoNotFitTheRendererAreRefusedBeforeAnythingIsWritten) {
       {{"sim", "plots", "--out", out, "--count", "2", "--stage", "early,mid,mature"}, "stages"},
       {{"simulate", "--out", out, "--plots", "2", "--stage", "early,mid,mature"}, "stages"},
       {{"simulate", "--out", out, "--renderer", "splat", "--stage", "mature"}, "--stage"},
+      {{"simulate", "--out", out, "--traits-config", bad_traits.string()},
+       bad_traits.string() + ":1: slice_width_quantile"},
+      {{"sim", "plots", "--out", out, "--traits-config", (dir / "absent.yaml").string()},
+       "absent.yaml"},
   };
   for (const auto& [args, named] : cases) {
     std::string joined;

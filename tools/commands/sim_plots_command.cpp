@@ -7,7 +7,9 @@
 // ideal rig; mesh: Embree-rendered triangle-mesh plants through the calibrated, distorted rig,
 // with per-pixel truth beside each frame) and, for the mesh renderer, `--stage` (early, mid,
 // mature, or a comma-separated list splitting the plots into blocks; given alone it selects the
-// mesh renderer). The scenes and their truth are sim/field's (synthetic_field.h).
+// mesh renderer), and `--traits-config FILE`: the trait definitions the truth lines are computed
+// with (those the session will be processed with). The scenes and their truth are sim/field's
+// (synthetic_field.h).
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -15,6 +17,7 @@
 #include <tuple>
 
 #include "commands/command_helpers.h"
+#include "fieldrig/config/traits_config.h"
 #include "fieldrig/sim/synthetic_field.h"
 
 namespace fieldrig::tools {
@@ -28,6 +31,7 @@ struct SceneArgs {
   std::string renderer;
   std::vector<std::string> stages;
   bool no_truth_maps = false;
+  std::string traits_config;
   CLI::Option* renderer_option = nullptr;
   CLI::Option* stage_option = nullptr;
   CLI::Option* height_min_option = nullptr;
@@ -67,12 +71,16 @@ void addSceneOptions(CLI::App& command, SceneArgs& scene) {
           ->check(CLI::IsMember({"early", "mid", "mature"}));
   command.add_flag("--no-truth-maps", scene.no_truth_maps,
                    "Mesh renderer: no depth/plot/plant/vegetation maps beside the frames");
+  command.add_option("--traits-config", scene.traits_config,
+                     "Traits options (YAML, as `fieldrig process --traits-config`) the truth is "
+                     "computed with (default: the shipped definitions)");
 }
 
 // Applies the scene options to the series' fields; the error names the flag.
 std::optional<std::string> applySceneArgs(const SceneArgs& scene, sim::SceneRenderer& renderer,
                                           std::vector<sim::GrowthStage>& stages,
-                                          bool& stage_heights, bool& truth_maps) {
+                                          bool& stage_heights, bool& truth_maps,
+                                          traits::TraitsOptions& truth_traits) {
   const bool stage_given = scene.stage_option->count() > 0;
   renderer = sim::SceneRenderer::kSplat;
   if (scene.renderer_option->count() > 0)
@@ -90,6 +98,12 @@ std::optional<std::string> applySceneArgs(const SceneArgs& scene, sim::SceneRend
   }
   stage_heights = scene.height_min_option->count() == 0 && scene.height_max_option->count() == 0;
   truth_maps = !scene.no_truth_maps;
+  if (!scene.traits_config.empty()) {
+    auto loaded = config::loadTraitsOptions(scene.traits_config);
+    if (!loaded)
+      return "--traits-config: " + loaded.error().message;
+    truth_traits = *loaded;
+  }
   return std::nullopt;
 }
 
@@ -109,7 +123,7 @@ struct PlotsArgs {
 int runPlots(const PlotsArgs& args) {
   sim::PlotSeries series = args.series;
   if (auto error = applySceneArgs(args.scene, series.renderer, series.stages, series.stage_heights,
-                                  series.truth_maps))
+                                  series.truth_maps, series.truth_traits))
     return fail("fieldrig sim plots: ", *error);
   if (auto error = sim::validatePlotSeries(series))
     return fail("fieldrig sim plots: ", *error);
@@ -142,7 +156,7 @@ struct FieldArgs {
 int runSimulate(const FieldArgs& args) {
   sim::FieldSpec spec = args.spec;
   if (auto error = applySceneArgs(args.scene, spec.renderer, spec.stages, spec.stage_heights,
-                                  spec.truth_maps))
+                                  spec.truth_maps, spec.truth_traits))
     return fail("fieldrig simulate: ", *error);
   if (auto error = sim::validatePlotSeries(sim::fieldPlotSeries(spec, spec.plots)))
     return fail("fieldrig simulate: ", *error);

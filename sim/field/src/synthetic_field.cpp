@@ -23,6 +23,7 @@ PlotSeries fieldPlotSeries(const FieldSpec& spec, int plots) {
   series.stages = spec.stages;
   series.stage_heights = spec.stage_heights;
   series.truth_maps = spec.truth_maps;
+  series.truth_traits = spec.truth_traits;
   return series;
 }
 

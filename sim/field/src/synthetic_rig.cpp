@@ -148,8 +148,9 @@ class SyntheticSession {
   std::ofstream truth_file_;
 };
 
-Json splatTruthLine(const RecordedPlot& plot_info, const PlotCloud& plot) {
-  const traits::TraitsResult truth = plotTruth(plot, traits::TraitsOptions{}).definitions;
+Json splatTruthLine(const RecordedPlot& plot_info, const PlotCloud& plot,
+                    const traits::TraitsOptions& definitions) {
+  const traits::TraitsResult truth = plotTruth(plot, definitions).definitions;
   Json line;
   line["plot"] = plot_info.location_id;
   line["set"] = plot_info.set_index;
@@ -199,7 +200,7 @@ core::Result<std::vector<RecordedPlot>> recordSplatPlots(
     plot_info.set_index = *written;
     plot_info.render_seconds = secondsSince(start);
     const auto truth_start = std::chrono::steady_clock::now();
-    session.writeTruth(splatTruthLine(plot_info, plot));
+    session.writeTruth(splatTruthLine(plot_info, plot, series.truth_traits));
     plot_info.truth_seconds = secondsSince(truth_start);
     recorded.push_back(plot_info);
     if (progress)
@@ -316,6 +317,7 @@ core::Result<std::vector<RecordedPlot>> recordMeshPlots(
     const auto truth_start = std::chrono::steady_clock::now();
     MeshTruthOptions truth_options;
     truth_options.seed = spec.plot.seed;
+    truth_options.traits = series.truth_traits;
     const MeshPlotTruth truth = meshPlotTruth(**scene, cameras, truth_options);
     const traits::TraitsResult& d = truth.traits.definitions;
     Json line;

@@ -31,6 +31,7 @@
 #include "fieldrig/gps/trigger_planner.h"
 #include "fieldrig/sim/mesh_scene.h"
 #include "fieldrig/sim/plot_generator.h"
+#include "fieldrig/traits/plot_traits.h"
 
 namespace fieldrig::sim {
 
@@ -75,6 +76,9 @@ struct PlotSeries {
   std::vector<GrowthStage> stages{GrowthStage::kMid};
   bool stage_heights = true;
   bool truth_maps = true;  // mesh: depth, plot, plant and vegetation maps beside each frame
+  // The trait definitions the truth lines are computed with: those the session will be processed
+  // with (`--traits-config`), so that truth and measurement define height and width alike.
+  traits::TraitsOptions truth_traits;
 };
 PlotSpec plotSpec(const PlotSeries& series, int index);
 // The mesh scene of plot `index`: stage and height as above, 3 m plots of 20 plants at 0.15 m
@@ -128,6 +132,7 @@ struct FieldSpec {
   std::vector<GrowthStage> stages{GrowthStage::kMid};  // mesh: as PlotSeries
   bool stage_heights = true;
   bool truth_maps = true;
+  traits::TraitsOptions truth_traits;  // as PlotSeries
 };
 
 struct FieldFiles {
