@@ -439,6 +439,10 @@ class Daemon {
       if (stop_requested_)
         return;
       acquisition_->waitForRoom(room);  // a stop request (signal) ends the wait too
+      // A wait ended by the stop leaves no room: a set triggered now would be skipped by live
+      // processing. The set in flight is finished; nothing more is triggered.
+      if (stop_requested_)
+        return;
       if (event.fix)
         onFix(*event.fix);
       onTrigger(event);
