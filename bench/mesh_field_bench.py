@@ -14,7 +14,8 @@ Usage: bench/mesh_field_bench.py [BUILD_DIR] [--plots 24] [--rows 2] [--seed 11]
        [--keep] [--process-args ARGS] [--traits-config FILE]
 --traits-config sets the trait definitions of both the truth and the processing. With --out the
 field and results stay in DIR and a field already there is reused (delete it to remake; one made
-with other traits options is refused); without it they go to a temporary folder. Rendering takes ~5-10 s a plot on 2 cores.
+with other traits options is refused); without it they go to a temporary folder. Rendering
+takes ~5-10 s a plot on 2 cores.
 """
 import argparse
 import json
