@@ -55,6 +55,7 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
           {"ground_tilt_limit_deg", numberIn(o.ground_tilt_limit_deg, 0, 90)},
           {"max_ground_shift_m", numberIn(o.max_ground_shift_m, 0, 10)},
           {"ground_margin_m", nonNegative(o.ground_margin_m)},
+          {"row_base_band_m", numberIn(o.row_base_band_m, 0, 1)},
           {"ground_tilt_deg", numberIn(o.ground_tilt_deg, 0, 90, true)},
           {"row_length_m", positive(o.row_length_m)},
           {"crop_to_row_length", flag(o.crop_to_row_length)},

@@ -131,6 +131,7 @@ void expectSame(const traits::TraitsOptions& actual, const traits::TraitsOptions
   EXPECT_FIELD(ground_tilt_limit_deg);
   EXPECT_FIELD(max_ground_shift_m);
   EXPECT_FIELD(ground_margin_m);
+  EXPECT_FIELD(row_base_band_m);
   EXPECT_FIELD(ground_tilt_deg);
   EXPECT_FIELD(row_length_m);
   EXPECT_FIELD(crop_to_row_length);
@@ -836,6 +837,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
                                   "max_ground_tilt_deg: 20\n"
                                   "ground_tilt_limit_deg: 6\n"
                                   "ground_margin_m: 0.02\n"
+                                  "row_base_band_m: 0.1\n"
                                   "ground_tilt_deg: 12\n"
                                   "row_length_m: 3\n"
                                   "intra_row_spacing_m: 0.1\n"
@@ -875,6 +877,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
   expected.max_ground_tilt_deg = 20;
   expected.ground_tilt_limit_deg = 6;
   expected.ground_margin_m = 0.02;
+  expected.row_base_band_m = 0.1;
   expected.ground_tilt_deg = 12;
   expected.row_length_m = 3;
   expected.intra_row_spacing_m = 0.1;

@@ -102,6 +102,7 @@ nlohmann::ordered_json traitsToJson(const TraitsResult& r, bool with_slices) {
                   {"ground_tilt_limited", q.ground_tilt_limited},
                   {"icp_ground_shift_m", q.icp_ground_shift_m},
                   {"ground_from_data_pose", q.ground_from_data_pose},
+                  {"ground_row_base_shift_m", q.ground_row_base_shift_m},
                   {"base_edge_centre",
                    {q.base_edge_centre.x(), q.base_edge_centre.y(), q.base_edge_centre.z()}},
                   {"slices", q.slices},

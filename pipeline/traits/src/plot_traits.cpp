@@ -74,6 +74,62 @@ PlatePose initialPlatePose(const Points& points, double strip) {
   return pose;
 }
 
+// How far along `normal` the soil where the stems stand lies from the ground through
+// `edge_centre`: the densest 1.5 cm layer of the points within `band` across the row of the base
+// edge and within `max_shift` of the ground. Soil seen between the stems fills one layer; stems
+// and leaves spread over all of them, so a layer holding less than twice the average is no soil
+// (the row base hidden by leaves): 0 then.
+double rowBaseGroundShift(const Points& points, const Eigen::Vector3d& edge_centre,
+                          const Eigen::Vector3d& normal, const Eigen::Vector3d& across, double band,
+                          double max_shift) {
+  constexpr double kBin = 0.005;
+  constexpr int kWindow = 3;  // bins in a layer
+  constexpr std::size_t kMinLayerPoints = 20;
+  const int bins = static_cast<int>(std::ceil(2.0 * max_shift / kBin));
+  if (bins < kWindow)
+    return 0.0;
+  std::vector<std::size_t> histogram(static_cast<std::size_t>(bins), 0);
+  std::size_t counted = 0;
+  for (const Eigen::Vector3f& p : points) {
+    const Eigen::Vector3d d = p.cast<double>() - edge_centre;
+    if (std::abs(across.dot(d)) > band)
+      continue;
+    const int b = static_cast<int>(std::floor((normal.dot(d) + max_shift) / kBin));
+    if (b >= 0 && b < bins) {
+      ++histogram[static_cast<std::size_t>(b)];
+      ++counted;
+    }
+  }
+  std::size_t best = 0;
+  int best_first = 0;
+  for (int first = 0; first + kWindow <= bins; ++first) {
+    std::size_t layer = 0;
+    for (int b = first; b < first + kWindow; ++b)
+      layer += histogram[static_cast<std::size_t>(b)];
+    if (layer > best) {
+      best = layer;
+      best_first = first;
+    }
+  }
+  const double average_layer = static_cast<double>(counted) * kWindow / static_cast<double>(bins);
+  if (best < kMinLayerPoints || static_cast<double>(best) < 2.0 * average_layer)
+    return 0.0;
+  // The layer's mean height, so that the shift is not quantised to the bins.
+  double sum = 0.0;
+  std::size_t n = 0;
+  const double lo = -max_shift + best_first * kBin;
+  const double hi = lo + kWindow * kBin;
+  for (const Eigen::Vector3f& p : points) {
+    const Eigen::Vector3d d = p.cast<double>() - edge_centre;
+    const double h = normal.dot(d);
+    if (std::abs(across.dot(d)) <= band && h >= lo && h < hi) {
+      sum += h;
+      ++n;
+    }
+  }
+  return n > 0 ? sum / static_cast<double>(n) : 0.0;
+}
+
 }  // namespace
 
 namespace {
@@ -126,6 +182,7 @@ std::optional<OptionsProblem> TraitsOptions::validate() const {
       outOfRange("ground_tilt_limit_deg", ground_tilt_limit_deg, 0, 90),
       outOfRange("max_ground_shift_m", max_ground_shift_m, 0, 10),
       outOfRange("ground_margin_m", ground_margin_m, 0, 1),
+      outOfRange("row_base_band_m", row_base_band_m, 0, 1),
       outOfRange("ground_tilt_deg", ground_tilt_deg, 0, 90, true),
       outOfRange("row_length_m", row_length_m, 0.01, 100),
       outOfRange("intra_row_spacing_m", intra_row_spacing_m, 0.001, 10),
@@ -543,9 +600,15 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
   }
   const Eigen::Matrix3d r = plate_transform.block<3, 3>(0, 0);
   const Eigen::Vector3d t = plate_transform.block<3, 1>(0, 3);
-  const Eigen::Vector3d edge_centre = r * data_edge_centre + t;
   const Eigen::Vector3d normal = r * Eigen::Vector3d::UnitX();
   const Eigen::Vector3d across = r * Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d edge_centre = r * data_edge_centre + t;
+  if (options.row_base_band_m > 0.0) {
+    const double shift = rowBaseGroundShift(cloud, edge_centre, normal, across,
+                                            options.row_base_band_m, options.max_ground_shift_m);
+    edge_centre += shift * normal;
+    q.ground_row_base_shift_m = shift;
+  }
   q.base_edge_centre = edge_centre;
   // Below the plate's ground (plus a noise margin) is soil; so is whatever lies below the planes
   // tilted by 10 degrees about the base-ground edge, on both sides: clods and weeds in front, and
@@ -582,6 +645,7 @@ TraitsResult computeTraits(const std::vector<Eigen::Vector3f>& points, InputFram
   traits.quality.icp_fell_back = q.icp_fell_back;
   traits.quality.icp_ground_shift_m = q.icp_ground_shift_m;
   traits.quality.ground_from_data_pose = q.ground_from_data_pose;
+  traits.quality.ground_row_base_shift_m = q.ground_row_base_shift_m;
   traits.quality.ground_tilt_deg = q.ground_tilt_deg;
   traits.quality.ground_tilt_fitted_deg = q.ground_tilt_fitted_deg;
   traits.quality.ground_tilt_limited = q.ground_tilt_limited;

@@ -43,6 +43,8 @@ TEST(TraitsOptionsValidate, NamesTheKeyAndTheRange) {
       {"voxel_leaf_m", [](TraitsOptions& o) { o.voxel_leaf_m = 0; }, "[0.001, 1]"},
       {"min_piece_voxels", [](TraitsOptions& o) { o.min_piece_voxels = -1; }, "[0, 1000000]"},
       {"alpha", [](TraitsOptions& o) { o.alpha = 1; }, "[0, 1)"},
+      {"row_base_band_m", [](TraitsOptions& o) { o.row_base_band_m = -0.01; }, "[0, 1]"},
+      {"row_base_band_m", [&](TraitsOptions& o) { o.row_base_band_m = kNan; }, "[0, 1]"},
       {"slice_width_quantile", [](TraitsOptions& o) { o.slice_width_quantile = 0.3; }, "[0, 0.25]"},
       {"slice_width_quantile", [](TraitsOptions& o) { o.slice_width_quantile = -0.01; },
        "[0, 0.25]"},

@@ -102,6 +102,7 @@ TEST(TraitsTruth, GroundTiltBeyondTheLimitIsTurnedBackAndReported) {
   const sim::PlotCloud plot = sim::generatePlot(spec);
   TraitsOptions free;
   free.ground_tilt_limit_deg = 0.0;
+  free.row_base_band_m = 0.0;  // the plate's own ground: the edge positions below compare it
   const TraitsResult unlimited = computeTraits(plot.points, InputFrame::kPlot, free);
   ASSERT_EQ(unlimited.status, TraitsStatus::kOk) << unlimited.message;
   EXPECT_FALSE(unlimited.quality.ground_tilt_limited);
@@ -110,6 +111,7 @@ TEST(TraitsTruth, GroundTiltBeyondTheLimitIsTurnedBackAndReported) {
 
   TraitsOptions limited_options;
   limited_options.ground_tilt_limit_deg = 4.0;
+  limited_options.row_base_band_m = 0.0;
   const TraitsResult limited = computeTraits(plot.points, InputFrame::kPlot, limited_options);
   ASSERT_EQ(limited.status, TraitsStatus::kOk) << limited.message;
   EXPECT_TRUE(limited.quality.ground_tilt_limited);
@@ -126,12 +128,14 @@ TEST(TraitsTruth, GroundTiltBeyondTheLimitIsTurnedBackAndReported) {
 // trips it; with the default the registration's small correction stands.
 TEST(TraitsTruth, ARegistrationMovingTheGroundTooFarGivesWayToTheDataLayer) {
   const sim::PlotCloud plot = sim::generatePlot(testSpec(1.5, 0.003, 25));
-  const TraitsResult registered = computeTraits(plot.points, InputFrame::kPlot, TraitsOptions{});
+  TraitsOptions plate_only;  // the registration's ground as it is, not moved to the row's base
+  plate_only.row_base_band_m = 0.0;
+  const TraitsResult registered = computeTraits(plot.points, InputFrame::kPlot, plate_only);
   ASSERT_EQ(registered.status, TraitsStatus::kOk) << registered.message;
   EXPECT_FALSE(registered.quality.ground_from_data_pose);
   EXPECT_LT(std::abs(registered.quality.icp_ground_shift_m), TraitsOptions{}.max_ground_shift_m);
   ASSERT_NE(registered.quality.icp_ground_shift_m, 0.0) << "nothing for the guard to refuse";
-  TraitsOptions strict;
+  TraitsOptions strict = plate_only;
   strict.max_ground_shift_m = 0.0;
   const TraitsResult from_data = computeTraits(plot.points, InputFrame::kPlot, strict);
   ASSERT_EQ(from_data.status, TraitsStatus::kOk) << from_data.message;
@@ -141,6 +145,63 @@ TEST(TraitsTruth, ARegistrationMovingTheGroundTooFarGivesWayToTheDataLayer) {
               1e-6);
   // The data's layer is a 1 cm histogram bin: the ground within about a centimetre either way.
   EXPECT_NEAR(from_data.quality.base_edge_centre.x(), plot.truth.ground_x_m, 0.015);
+}
+
+// A planting ridge: the row stands on soil raised by `ridge_m` at the stems, a strip about 12 cm
+// wide. The plants are lifted with it, so their heights above the soil at their stems are
+// those of the flat plot.
+sim::PlotCloud withPlantingRidge(sim::PlotCloud plot, double ridge_m) {
+  const double base = plot.truth.base_depth_m;
+  for (std::size_t i = 0; i < plot.points.size(); ++i) {
+    Eigen::Vector3f& p = plot.points[i];
+    switch (plot.labels[i]) {
+      case sim::SurfaceLabel::kSoil:
+        p.x() += static_cast<float>(ridge_m * std::exp(-std::pow((p.z() - base) / 0.06, 2.0)));
+        break;
+      case sim::SurfaceLabel::kStem:
+      case sim::SurfaceLabel::kLeaf:
+      case sim::SurfaceLabel::kWhorl:
+        p.x() += static_cast<float>(ridge_m);
+        break;
+      default:
+        break;
+    }
+  }
+  for (sim::PlotSample& s : plot.truth.visible_plant_samples)
+    s.position.x() += static_cast<float>(ridge_m);
+  plot.truth.ground_x_m += ridge_m;
+  return plot;
+}
+
+// The plate's soil strip reaches 30 cm in front of the row, over the ridge's flank: its ground
+// settles below the soil the stems stand in, and every height comes out that much too tall (4 cm
+// on the rendered field's 4 cm ridges). The densest layer at the row's base puts it back.
+TEST(TraitsTruth, OnAPlantingRidgeTheGroundIsTheSoilAtTheStems) {
+  const double ridge = 0.05;
+  const sim::PlotCloud flat = sim::generatePlot(testSpec(1.2, 0.002, 26));
+  const sim::PlotCloud ridged = withPlantingRidge(flat, ridge);
+  const double truth_height = plotTruth(ridged, TraitsOptions{}).definitions.height_m;
+
+  TraitsOptions plate_only;
+  plate_only.row_base_band_m = 0.0;
+  const TraitsResult plate = computeTraits(ridged.points, InputFrame::kPlot, plate_only);
+  ASSERT_EQ(plate.status, TraitsStatus::kOk) << plate.message;
+  EXPECT_LT(plate.quality.base_edge_centre.x(), ridged.truth.ground_x_m - 0.015)
+      << "the plate alone finds the ridge top: nothing for the option to correct";
+  EXPECT_DOUBLE_EQ(plate.quality.ground_row_base_shift_m, 0.0);
+
+  const TraitsResult at_stems = computeTraits(ridged.points, InputFrame::kPlot, TraitsOptions{});
+  ASSERT_EQ(at_stems.status, TraitsStatus::kOk) << at_stems.message;
+  EXPECT_NEAR(at_stems.quality.base_edge_centre.x(), ridged.truth.ground_x_m, 0.01);
+  EXPECT_GT(at_stems.quality.ground_row_base_shift_m, 0.015);
+  EXPECT_NEAR(at_stems.height_m, truth_height, 0.015);
+  EXPECT_GT(plate.height_m - truth_height, at_stems.height_m - truth_height + 0.01);
+
+  // Flat soil: the layer at the stems is the plate's own ground, and it stays.
+  const TraitsResult on_flat = computeTraits(flat.points, InputFrame::kPlot, TraitsOptions{});
+  ASSERT_EQ(on_flat.status, TraitsStatus::kOk) << on_flat.message;
+  EXPECT_LT(std::abs(on_flat.quality.ground_row_base_shift_m), 0.01);
+  EXPECT_NEAR(on_flat.quality.base_edge_centre.x(), flat.truth.ground_x_m, 0.01);
 }
 
 // Paper claim 1: the weighted median of per-slice maxima ignores a single abnormal tall plant.
