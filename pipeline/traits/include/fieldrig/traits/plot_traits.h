@@ -80,10 +80,10 @@ struct TraitsOptions {
   // Slicing (equation 15): n = ceil(2 * row length / intra-row spacing) unless slices > 0.
   double row_length_m = 1.5;
   // Only plant points within ±row_length_m / 2 of the plot's location (y = 0) are the plot's.
-  // Off: on the 24-plot rendered field (bench/mesh_field_bench.py, seed 11) it made every trait
-  // worse against the mesh truth (width 6.6 → 8.3 cm mean abs, VVI 5.7 → 7.8 %). The truth counts
-  // all of the plot's own plants; why cropping to the row loses more than the neighbours add is
-  // not yet known.
+  // Off: on the 24-plot rendered field (bench/mesh_field_bench.py, seed 11, the truth cropped
+  // alike) width against what any camera sees stayed as it was (6.6 → 6.8 cm mean abs) and VVI got
+  // worse (5.7 → 7.9 %); against what both cameras of a head see, width improved (5.7 → 4.8 cm on
+  // the plots in view). An earlier "worse" (width 8.3 cm) was against an uncropped truth.
   bool crop_to_row_length = false;
   double intra_row_spacing_m = 0.15;
   int slices = 0;
