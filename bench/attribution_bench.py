@@ -19,11 +19,13 @@ Makes (or reuses) a synthetic field as bench/mesh_field_bench.py does (`fieldrig
       that filter costs with perfect depth, where it drops the outermost leaf edges.
   (c) stereo (SGBM, the rig's path), with `--score-stereo`.
 (b) − (a) is what fusion, crop and the traits code cost with perfect depth; (c) − (b) is what
-stereo costs. Per trait: mean absolute error, worst, bias (heights and widths in cm, VVI and VAI
-relative to the truth). Per head, stereo against the per-pixel truth on vegetation pixels whose
-truth depth lies inside the depth crop: the fraction matched, the bad-pixel rate (|disparity
-error| > 2 px at matching resolution, of the matched ones) and the median depth error; and each
-head's points in the fused cloud from (b) and (c). The last line is one JSON summary.
+stereo costs. For (b), (b') and (c), the near and far edges of each plot's box against the
+truth's box say on which side of the row the width was lost or gained. Per trait: mean absolute
+error, worst, bias (heights and widths in cm, VVI and VAI relative to the truth). Per head,
+stereo against the per-pixel truth on vegetation pixels whose truth depth lies inside the depth
+crop: the fraction matched, the bad-pixel rate (|disparity error| > 2 px at matching
+resolution, of the matched ones) and the median depth error; and each head's points in the fused
+cloud from (b) and (c). The last line is one JSON summary.
 
 Usage: bench/attribution_bench.py [BUILD_DIR] [--plots 8] [--rows 2] [--seed 11] [--out DIR]
        [--process-args ARGS] [--traits-config FILE]
@@ -165,6 +167,30 @@ def main():
             cells.append("—")
     summary["stereo_cost"] = cost
     print("| stereo's share, (c) − (b) | " + " | ".join(cells) + " |")
+
+    # A width error is a near edge (toward the cameras) or a far edge out of place: each plot's
+    # refined box against the truth's, so a fix can aim at the side that moved.
+    print(f"\nWhere the width goes: each plot's box edges against the truth's (z_min, the near "
+          f"edge; z_max, the far edge; + is away from the cameras), {len(plots)} plots: mean abs "
+          f"/ worst / bias")
+    print("| row | near edge | far edge |")
+    print("| --- | --- | --- |")
+    summary["edges"] = {}
+    for label, measured in rows[3:]:
+        cells, row_summary = [], {}
+        for edge, key in (("near", "z_min"), ("far", "z_max")):
+            errors = [measured[p]["box"][key] - truth[p][key + "_m"] for p in plots
+                      if "box" in measured[p] and key + "_m" in truth[p]]
+            if not errors:
+                cells.append("—")
+                continue
+            s = {"n": len(errors), "mean_abs": sum(abs(e) for e in errors) / len(errors),
+                 "max_abs": max(abs(e) for e in errors), "bias": sum(errors) / len(errors)}
+            row_summary[edge] = s
+            cells.append(f"{fmt(s['mean_abs'], False)} / {fmt(s['max_abs'], False)} / "
+                         f"{fmt(s['bias'], False, True)}")
+        summary["edges"][label.split(" ")[0]] = row_summary
+        print(f"| {label} | " + " | ".join(cells) + " |")
 
     print("\nPer head, stereo against the per-pixel truth (vegetation pixels inside the depth crop; "
           "bad = |disparity error| > 2 px at matching resolution, of the matched pixels); "
