@@ -14,9 +14,10 @@ Makes (or reuses) a synthetic field as bench/mesh_field_bench.py does (`fieldrig
       definitions on all of the plot's surfaces, seen or not).
   (b) `--depth-source truth`: each head's left camera's rendered truth depth map (beside every
       frame) as its disparity → the same edge filter, reprojection, fusion, crop and traits.
-  (b') as (b) with the depth-edge filter off (the shipped config/fieldrigd.yaml with
-      pipeline.cloud.edge_max_jump_px 0; left out when --process-args names a --config): what
-      that filter costs with perfect depth, where it drops the outermost leaf edges.
+  (b') as (b) with the depth-edge filter on (the shipped config/fieldrigd.yaml with
+      pipeline.cloud.edge_max_jump_px 2, off by default; left out when --process-args names a
+      --config): what that filter would cost with perfect depth, where it drops the outermost
+      leaf edges and tips.
   (c) stereo (SGBM, the rig's path), with `--score-stereo`.
 (b) − (a) is what fusion, crop and the traits code cost with perfect depth; (c) − (b) is what
 stereo costs. For (b), (b') and (c), the near and far edges of each plot's box against the
@@ -90,22 +91,21 @@ def main():
     truth = read_truth(field)
     from_truth = process(fieldrig, field, os.path.join(work, "results-truth-depth"),
                          ["--depth-source", "truth"], args)
-    from_truth_no_edges = None
+    from_truth_edges = None
     if "--config" not in args.process_args:
         shipped = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "config",
                                "fieldrigd.yaml")
         with open(shipped) as f:
-            text, replaced = re.subn(r"edge_max_jump_px: *[0-9.]+", "edge_max_jump_px: 0",
+            text, replaced = re.subn(r"edge_max_jump_px: *[0-9.]+", "edge_max_jump_px: 2",
                                      f.read())
         if replaced != 1:
             sys.exit(f"{shipped}: expected one edge_max_jump_px, found {replaced}")
-        no_edges = os.path.join(work, "no-edge-filter.yaml")
-        with open(no_edges, "w") as f:
+        edges = os.path.join(work, "edge-filter.yaml")
+        with open(edges, "w") as f:
             f.write(text)
-        from_truth_no_edges = process(fieldrig, field,
-                                      os.path.join(work, "results-truth-depth-no-edge-filter"),
-                                      ["--depth-source", "truth", "--config", no_edges],
-                                      args)
+        from_truth_edges = process(fieldrig, field,
+                                   os.path.join(work, "results-truth-depth-edge-filter"),
+                                   ["--depth-source", "truth", "--config", edges], args)
     from_stereo = process(fieldrig, field, os.path.join(work, "results-stereo"),
                           ["--score-stereo"], args)
     for name, results in (("truth depth", from_truth), ("stereo", from_stereo)):
@@ -115,12 +115,12 @@ def main():
     plots = sorted(truth, key=lambda p: truth[p]["set"])
 
     print("| plot | stage | plants m | width m: truth | (a') full | (b) truth depth | "
-          "(b') no edge filter | (c) stereo |")
+          "(b') edge filter 2 px | (c) stereo |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
     for p in plots:
         t = truth[p]
         cells = [from_truth.get(p, {}).get("traits", {}).get("width_m"),
-                 (from_truth_no_edges or {}).get(p, {}).get("traits", {}).get("width_m"),
+                 (from_truth_edges or {}).get(p, {}).get("traits", {}).get("width_m"),
                  from_stereo.get(p, {}).get("traits", {}).get("width_m")]
         full = t.get("full", {}).get("width_m")
         print(f"| {p} | {t.get('stage', '?')} | {t['plant_height_m']:.2f} | {t['width_m']:.3f} | "
@@ -133,7 +133,7 @@ def main():
          {p: truth[p].get("stereo_view", {}) for p in plots}),
         ("(b) truth depth → fusion → traits", {p: from_truth.get(p, {}).get("traits", {})
                                                for p in plots}),
-        ("(b') truth depth, no edge filter", {p: (from_truth_no_edges or {}).get(p, {})
+        ("(b') truth depth, edge filter 2 px", {p: (from_truth_edges or {}).get(p, {})
                                              .get("traits", {}) for p in plots}),
         ("(c) SGBM → fusion → traits", {p: from_stereo.get(p, {}).get("traits", {})
                                         for p in plots}),

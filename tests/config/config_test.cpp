@@ -648,7 +648,7 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
       "pipeline:\n"
       "  enabled: false\n"
       "  queue_sets: 3\n"
-      "  cloud: {scale: 0.25, min_depth_m: 0.3, max_depth_m: 2.5, edge_max_jump_px: 0,\n"
+      "  cloud: {scale: 0.25, min_depth_m: 0.3, max_depth_m: 2.5, edge_max_jump_px: 3.5,\n"
       "          edge_keep_near_side: true}\n"
       "  matcher:\n"
       "    num_disparities: 64\n"
@@ -727,7 +727,7 @@ TEST(ConfigSections, EveryKeyReachesItsField) {
   cloud_options.scale = 0.25;
   cloud_options.min_depth_m = 0.3;
   cloud_options.max_depth_m = 2.5;
-  cloud_options.edge_max_jump_px = 0;
+  cloud_options.edge_max_jump_px = 3.5;
   cloud_options.edge_keep_near_side = true;
   cloud_options.matcher = matcher;
   expectSame(c.pipeline.cloud, cloud_options);

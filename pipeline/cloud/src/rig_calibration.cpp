@@ -119,16 +119,17 @@ core::Result<RigCalibration> loadCheckedRig(const fs::path& directory) {
     rig.plot_rotation = cv::Matx33d(rotation);
   }
   // Processing options that earlier versions wrote here, each with the default they were written
-  // with (CloudOptions' own): such a file still loads; a changed value must move to the
-  // configuration, where it takes effect, rather than be ignored here.
+  // with: such a file still loads; a changed value must move to the configuration, where it takes
+  // effect, rather than be ignored here. The edge filter was written at 2 px, its default then.
   const CloudOptions defaults;
+  constexpr double kWrittenEdgeMaxJumpPx = 2.0;
   const std::pair<const char*, double> legacy_options[] = {
       {"max_depth_m", defaults.max_depth_m},
       {"min_depth_m", defaults.min_depth_m},
       {"scale", defaults.scale},
       {"min_disparity", defaults.matcher.min_disparity},
       {"num_disparities", defaults.matcher.num_disparities},
-      {"edge_max_jump_px", defaults.edge_max_jump_px},
+      {"edge_max_jump_px", kWrittenEdgeMaxJumpPx},
   };
   for (const auto& [key, default_value] : legacy_options) {
     const cv::FileNode node = storage[key];
