@@ -13,7 +13,8 @@ Makes (or reuses) a synthetic field as bench/mesh_field_bench.py does (`fieldrig
       "(a') full geometry" shows what the view itself hides (the truth's `full` block: the same
       definitions on all of the plot's surfaces, seen or not).
   (b) `--depth-source truth`: each head's left camera's rendered truth depth map (beside every
-      frame) as its disparity → the same edge filter, reprojection, fusion, crop and traits.
+      frame) as its disparity → the shipped chain after matching: edge filter (off by default),
+      reprojection, fusion, crop and traits.
   (b') as (b) with the depth-edge filter on (the shipped config/fieldrigd.yaml with
       pipeline.cloud.edge_max_jump_px 2, off by default; left out when --process-args names a
       --config): what that filter would cost with perfect depth, where it drops the outermost
@@ -134,7 +135,7 @@ def main():
         ("(b) truth depth → fusion → traits", {p: from_truth.get(p, {}).get("traits", {})
                                                for p in plots}),
         ("(b') truth depth, edge filter 2 px", {p: (from_truth_edges or {}).get(p, {})
-                                             .get("traits", {}) for p in plots}),
+                                               .get("traits", {}) for p in plots}),
         ("(c) SGBM → fusion → traits", {p: from_stereo.get(p, {}).get("traits", {})
                                         for p in plots}),
     ]
@@ -179,13 +180,11 @@ def main():
     for label, measured in rows[3:]:
         cells, row_summary = [], {}
         for edge, key in (("near", "z_min"), ("far", "z_max")):
-            errors = [measured[p]["box"][key] - truth[p][key + "_m"] for p in plots
-                      if "box" in measured[p] and key + "_m" in truth[p]]
-            if not errors:
+            s = stats([(measured[p].get("box", {}).get(key), truth[p].get(key + "_m"))
+                       for p in plots], relative=False)
+            if s is None:
                 cells.append("—")
                 continue
-            s = {"n": len(errors), "mean_abs": sum(abs(e) for e in errors) / len(errors),
-                 "max_abs": max(abs(e) for e in errors), "bias": sum(errors) / len(errors)}
             row_summary[edge] = s
             cells.append(f"{fmt(s['mean_abs'], False)} / {fmt(s['max_abs'], False)} / "
                          f"{fmt(s['bias'], False, True)}")

@@ -30,10 +30,10 @@ struct CloudOptions {
   // as "flying" points between a leaf and what is behind it. 0 (the default) keeps them: on three
   // 24-plot rendered fields (bench/attribution_bench.py, seeds 11-13) 2 px dropped mostly real
   // leaf edges and tips. With rendered truth depth it cost 1.8 cm of width (mean abs 2.7 → 4.5
-  // cm, seed 11); from stereo, turned off, the width's mean abs error (plots inside the view)
-  // fell 0.7-1.3 cm on every field against both truths (what any camera sees, what both cameras of
-  // a head see) and its worst nowhere rose, while points > 3 cm off the surfaces went from 7.8-10.1
-  // % to 8.8-11.1 %.
+  // cm, seed 11). From stereo, turned off, the width's mean abs error on the plots inside the
+  // view fell 0.7-1.3 cm on every field against both truths (what any camera sees, what both
+  // cameras of a head see) and its worst nowhere rose; points > 3 cm off the surfaces went from
+  // 7.8-10.1 % to 8.8-11.1 %.
   double edge_max_jump_px = 0.0;
   // With edge_max_jump_px > 0: drop only the far side of each such jump (a pixel with a
   // neighbour more than the jump nearer): the blend and the background beside a leaf go, the

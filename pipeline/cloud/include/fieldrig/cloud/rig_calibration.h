@@ -39,8 +39,8 @@ struct RigCalibration {
 // Reads DIR/rig.yml and each head's DIR/<name>/{intrinsics,extrinsics}.yml. The error names the
 // file and the field. Calibrations written before the processing options left rig.yml still
 // carry them (max_depth_m, min_depth_m, scale, min_disparity, num_disparities, edge_max_jump_px):
-// at the defaults they were written with they are ignored; any other value is an error saying where
-// the option lives now, so that a changed value is never dropped without a word.
+// at the values they were written with they are ignored; any other value is an error saying
+// where the option lives now, so that a changed value is never dropped without a word.
 core::Result<RigCalibration> loadRigCalibration(const std::filesystem::path& directory);
 // Writes DIR/rig.yml and each head's calibration below DIR. The error names the file.
 core::Result<std::filesystem::path> saveRigCalibration(const RigCalibration& rig,
