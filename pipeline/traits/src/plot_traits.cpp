@@ -10,6 +10,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "pcl_steps.h"
 
@@ -245,7 +246,7 @@ const char* statusName(TraitsStatus status) {
   return "unknown";
 }
 
-double weightedMedian(std::vector<std::pair<double, double>> value_weight) {
+double weightedQuantile(std::vector<std::pair<double, double>> value_weight, double q) {
   std::erase_if(value_weight, [](const auto& vw) {
     return !(vw.second > 0.0) || !std::isfinite(vw.first) || !std::isfinite(vw.second);
   });
@@ -258,10 +259,14 @@ double weightedMedian(std::vector<std::pair<double, double>> value_weight) {
   double cumulative = 0.0;
   for (const auto& vw : value_weight) {
     cumulative += vw.second;
-    if (cumulative >= 0.5 * total)
+    if (cumulative >= q * total)
       return vw.first;
   }
   return value_weight.back().first;
+}
+
+double weightedMedian(std::vector<std::pair<double, double>> value_weight) {
+  return weightedQuantile(std::move(value_weight), 0.5);
 }
 
 std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>& points,
@@ -381,6 +386,12 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& all_plant
   result.x_max = weightedMedian(x_max);
   result.z_min = weightedMedian(z_min);
   result.z_max = weightedMedian(z_max);
+  const auto spread = [](const std::vector<std::pair<double, double>>& value_weight) {
+    return weightedQuantile(value_weight, 0.75) - weightedQuantile(value_weight, 0.25);
+  };
+  result.quality.slice_top_spread_m = spread(x_max);
+  result.quality.slice_near_spread_m = spread(z_min);
+  result.quality.slice_far_spread_m = spread(z_max);
   result.height_m = result.x_max - result.x_min;
   result.width_m = result.z_max - result.z_min;
   result.timings.slices_ms = core::millisecondsSince(slices_start);

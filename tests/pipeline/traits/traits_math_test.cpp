@@ -7,6 +7,7 @@
 #include <numbers>
 #include <random>
 
+#include "fieldrig/traits/plot_report.h"
 #include "fieldrig/traits/plot_traits.h"
 #include "support/temp_dir.h"
 
@@ -84,6 +85,53 @@ TEST(SliceExtent, AWidthQuantileIgnoresTheStrayVoxelsAndLeavesTheTop) {
     EXPECT_LE(slice.z_max, 1.2 + 1e-6);
   }
   EXPECT_NEAR(result.height_m, 1.30, 1e-3);  // the top is still the slices' highest point
+}
+
+TEST(WeightedQuantile, IsTheFirstSortedValueReachingThatShareOfTheWeight) {
+  // Sorted: 1 (0.2), 2 (0.2), 3 (0.2), 10 (0.4): cumulative 0.2, 0.4, 0.6, 1.0.
+  const std::vector<std::pair<double, double>> values{
+      {10.0, 0.4}, {2.0, 0.2}, {1.0, 0.2}, {3.0, 0.2}};
+  EXPECT_DOUBLE_EQ(weightedQuantile(values, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(weightedQuantile(values, 0.25), 2.0);
+  EXPECT_DOUBLE_EQ(weightedQuantile(values, 0.5), weightedMedian(values));
+  EXPECT_DOUBLE_EQ(weightedQuantile(values, 0.75), 10.0);
+  EXPECT_DOUBLE_EQ(weightedQuantile(values, 1.0), 10.0);
+  EXPECT_DOUBLE_EQ(weightedQuantile({}, 0.25), 0.0);
+}
+
+// A 1 m long row of plant points 1.0-1.2 m from the camera, 1 m tall, or 1.3 m tall along the
+// half of the row at y > 0 (an off-type tall plant there).
+Points rowBlock(bool taller_half) {
+  Points points;
+  const float step = 0.02F;
+  for (int j = 0; j <= 50; ++j) {
+    const float y = -0.5F + j * step;
+    const int top = taller_half && y > 0.0F ? 65 : 50;
+    for (int i = 0; i <= top; ++i)
+      for (int k = 0; k <= 10; ++k)
+        points.emplace_back(i * step, y, 1.0F + k * step);
+  }
+  return points;
+}
+
+TEST(SliceSpread, IsSmallWhereTheSlicesAgreeAndShowsARowSplitInTwoLevels) {
+  const TraitsResult even = traitsFromPlantPoints(rowBlock(false), 0.0, TraitsOptions{});
+  ASSERT_TRUE(even.heightWidthValid()) << even.message;
+  EXPECT_LT(even.quality.slice_top_spread_m, 0.005);
+  EXPECT_LT(even.quality.slice_near_spread_m, 0.005);
+  EXPECT_LT(even.quality.slice_far_spread_m, 0.005);
+
+  const TraitsResult split = traitsFromPlantPoints(rowBlock(true), 0.0, TraitsOptions{});
+  ASSERT_TRUE(split.heightWidthValid()) << split.message;
+  // The height is one of the two levels; the spread says the slices disagree by the 30 cm step.
+  EXPECT_NEAR(split.quality.slice_top_spread_m, 0.30, 0.005);
+  EXPECT_LT(split.quality.slice_near_spread_m, 0.005);
+  EXPECT_LT(split.quality.slice_far_spread_m, 0.005);
+  const auto quality = traitsToJson(split).at("quality");
+  EXPECT_NEAR(quality.at("slice_top_spread_m").get<double>(), split.quality.slice_top_spread_m,
+              1e-12);
+  EXPECT_TRUE(quality.contains("slice_near_spread_m"));
+  EXPECT_TRUE(quality.contains("slice_far_spread_m"));
 }
 
 TEST(SliceCount, FollowsEquation15) {

@@ -175,6 +175,14 @@ struct TraitsQuality {
   int slices = 0;
   int occupied_slices = 0;
   int valid_slices = 0;
+  // How much the occupied slices disagree on their top, near edge and far edge: the weighted
+  // interquartile range of each, m. Height and width are weighted medians over the slices, so a
+  // plot whose slices split into two levels (a gap in the row, an off-type tall plant, a band of
+  // stray points) can move by up to this much with a small change in which points were matched;
+  // small spreads say the median stands on agreeing slices.
+  double slice_top_spread_m = 0.0;
+  double slice_near_spread_m = 0.0;
+  double slice_far_spread_m = 0.0;
   double alpha_margin = 0.0;  // smallest |ratio - alpha| over slices: how close beta is to flipping
   int slices_near_alpha = 0;
   bool area_computed = false;
@@ -227,6 +235,10 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& plant_poi
 // Weighted median as in the paper: sort the values, return the first whose cumulative weight
 // reaches half the total. Pairs with non-positive weight are ignored; 0 when nothing is left.
 double weightedMedian(std::vector<std::pair<double, double>> value_weight);
+
+// The same at any quantile q in [0, 1]: the first sorted value whose cumulative weight reaches
+// q times the total (q = 0.5 is weightedMedian).
+double weightedQuantile(std::vector<std::pair<double, double>> value_weight, double q);
 
 // Surface area by 2.5D depth-map triangulation (seen along +z): cells of `cell` metres in (x, y),
 // each holding the depth layers found there; neighbouring cells are joined into triangles where
