@@ -19,9 +19,12 @@ Makes (or reuses) a synthetic field as bench/mesh_field_bench.py does (`fieldrig
       pipeline.cloud.edge_max_jump_px 2, off by default; left out when --process-args names a
       --config): what that filter would cost with perfect depth, where it drops the outermost
       leaf edges and tips.
+  (c0) `--depth-source truth-where-matched`: stereo runs, then exactly the pixels it matched take
+      the truth's depth (the others none).
   (c) stereo (SGBM, the rig's path), with `--score-stereo`.
 (b) − (a) is what fusion, crop and the traits code cost with perfect depth; (c) − (b) is what
-stereo costs. For (b), (b') and (c), the near and far edges of each plot's box against the
+stereo costs, split into (c0) − (b), the pixels stereo leaves out, and (c) − (c0), the depth it
+gets wrong on the pixels it keeps. For (b), (b') and (c), the near and far edges of each plot's box against the
 truth's box say on which side of the row the width was lost or gained. Per trait: mean absolute
 error, worst, bias (heights and widths in cm, VVI and VAI relative to the truth). Per head,
 stereo against the per-pixel truth on vegetation pixels whose truth depth lies inside the depth
@@ -107,21 +110,25 @@ def main():
         from_truth_edges = process(fieldrig, field,
                                    os.path.join(work, "results-truth-depth-edge-filter"),
                                    ["--depth-source", "truth", "--config", edges], args)
+    from_coverage = process(fieldrig, field, os.path.join(work, "results-truth-where-matched"),
+                            ["--depth-source", "truth-where-matched"], args)
     from_stereo = process(fieldrig, field, os.path.join(work, "results-stereo"),
                           ["--score-stereo"], args)
-    for name, results in (("truth depth", from_truth), ("stereo", from_stereo)):
+    for name, results in (("truth depth", from_truth), ("truth where matched", from_coverage),
+                          ("stereo", from_stereo)):
         for plot in results:
             if plot not in truth:
                 sys.exit(f"{plot} ({name}): not in the truth")
     plots = sorted(truth, key=lambda p: truth[p]["set"])
 
     print("| plot | stage | plants m | width m: truth | (a') full | (b) truth depth | "
-          "(b') edge filter 2 px | (c) stereo |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+          "(b') edge filter 2 px | (c0) truth where matched | (c) stereo |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for p in plots:
         t = truth[p]
         cells = [from_truth.get(p, {}).get("traits", {}).get("width_m"),
                  (from_truth_edges or {}).get(p, {}).get("traits", {}).get("width_m"),
+                 from_coverage.get(p, {}).get("traits", {}).get("width_m"),
                  from_stereo.get(p, {}).get("traits", {}).get("width_m")]
         full = t.get("full", {}).get("width_m")
         print(f"| {p} | {t.get('stage', '?')} | {t['plant_height_m']:.2f} | {t['width_m']:.3f} | "
@@ -136,6 +143,8 @@ def main():
                                                for p in plots}),
         ("(b') truth depth, edge filter 2 px", {p: (from_truth_edges or {}).get(p, {})
                                                .get("traits", {}) for p in plots}),
+        ("(c0) truth depth where SGBM matched", {p: from_coverage.get(p, {}).get("traits", {})
+                                                for p in plots}),
         ("(c) SGBM → fusion → traits", {p: from_stereo.get(p, {}).get("traits", {})
                                         for p in plots}),
     ]
@@ -154,20 +163,23 @@ def main():
                          f"{fmt(s['bias'], relative, True)}")
         summary["rows"][label.split(" ")[0]] = row_summary
         print(f"| {label} | " + " | ".join(cells) + " |")
-    b, c = summary["rows"]["(b)"], summary["rows"]["(c)"]
-    cost = {}
-    cells = []
-    for key, _, unit in TRAITS:
-        relative = unit == ""
-        if b.get(key) and c.get(key):
-            cost[key] = {"mean_abs": c[key]["mean_abs"] - b[key]["mean_abs"],
-                         "bias": c[key]["bias"] - b[key]["bias"]}
-            cells.append(f"{fmt(cost[key]['mean_abs'], relative, True)} mean abs, "
-                         f"{fmt(cost[key]['bias'], relative, True)} bias")
-        else:
-            cells.append("—")
-    summary["stereo_cost"] = cost
-    print("| stereo's share, (c) − (b) | " + " | ".join(cells) + " |")
+    for name, (low, high), title in (
+            ("stereo_cost", ("(b)", "(c)"), "stereo's share, (c) − (b)"),
+            ("coverage_cost", ("(b)", "(c0)"), "of it, the pixels left out, (c0) − (b)"),
+            ("depth_error_cost", ("(c0)", "(c)"), "of it, the depth on the kept ones, (c) − (c0)")):
+        lo, hi = summary["rows"][low], summary["rows"][high]
+        cost, cells = {}, []
+        for key, _, unit in TRAITS:
+            relative = unit == ""
+            if lo.get(key) and hi.get(key):
+                cost[key] = {"mean_abs": hi[key]["mean_abs"] - lo[key]["mean_abs"],
+                             "bias": hi[key]["bias"] - lo[key]["bias"]}
+                cells.append(f"{fmt(cost[key]['mean_abs'], relative, True)} mean abs, "
+                             f"{fmt(cost[key]['bias'], relative, True)} bias")
+            else:
+                cells.append("—")
+        summary[name] = cost
+        print(f"| {title} | " + " | ".join(cells) + " |")
 
     # A width error is a near edge (toward the cameras) or a far edge out of place: each plot's
     # refined box against the truth's, so a fix can aim at the side that moved.

@@ -1,7 +1,8 @@
-// `fieldrig process --depth-source truth` and `--score-stereo` on sessions of `fieldrig sim plots`:
-// a rendered mesh plot processed from its truth depth maps goes through the same fusion, crop and
-// traits as stereo, with every left pixel measured; stereo is scored per head against the same
-// truth; a session without the truth maps is refused before anything is written, naming the file.
+// `fieldrig process --depth-source truth|truth-where-matched` and `--score-stereo` on sessions of
+// `fieldrig sim plots`: a rendered mesh plot processed from its truth depth maps goes through the
+// same fusion, crop and traits as stereo, with every left pixel measured, or only stereo's matched
+// pixels; stereo is scored per head against the same truth; a session without the truth maps is
+// refused before anything is written, naming the file.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -110,6 +111,50 @@ TEST(ProcessTruthDepthCli, TruthDepthGoesThroughTheSameChainAndStereoIsScoredAga
   EXPECT_FALSE(truth_bottom.contains("points_vs_truth"));
 }
 
+TEST(ProcessTruthDepthCli, TruthWhereMatchedKeepsStereosPixelsWithTheTruthsDepth) {
+  ScopedTempDir dir("process_truth_where_matched");
+  const fs::path session = dir / "session";
+  const auto made = runFieldrig(
+      {"sim", "plots", "--out", session.string(), "--count", "1", "--stage", "mid"}, dir.path());
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const auto stereo = runFieldrig(
+      {"process", session.string(), "--out", (dir / "stereo").string(), "--score-stereo"},
+      dir.path());
+  ASSERT_EQ(stereo.exit_code, 0) << stereo.err;
+  const auto matched =
+      runFieldrig({"process", session.string(), "--out", (dir / "matched").string(),
+                   "--depth-source", "truth-where-matched", "--score-stereo"},
+                  dir.path());
+  ASSERT_EQ(matched.exit_code, 0) << matched.err;
+  const auto from_truth = runFieldrig(
+      {"process", session.string(), "--out", (dir / "truth").string(), "--depth-source", "truth"},
+      dir.path());
+  ASSERT_EQ(from_truth.exit_code, 0) << from_truth.err;
+  const Json s = plotLine(stereo);
+  const Json m = plotLine(matched);
+  const Json t = plotLine(from_truth);
+  ASSERT_FALSE(s.is_null() || m.is_null() || t.is_null());
+  EXPECT_EQ(m.at("depth_source"), "truth-where-matched");
+  EXPECT_EQ(m.at("traits").at("status"), "ok") << m.dump();
+
+  const Json& stereo_bottom = head(s, "bottom");
+  const Json& matched_bottom = head(m, "bottom");
+  // The same matching ran: the same pixels matched, the same score against the truth.
+  EXPECT_EQ(matched_bottom.at("valid_pixel_fraction"), stereo_bottom.at("valid_pixel_fraction"));
+  EXPECT_EQ(matched_bottom.at("stereo_vs_truth"), stereo_bottom.at("stereo_vs_truth"));
+  // Its cloud has those pixels' points (less those on sky, which the truth has no depth for), all
+  // of them on the surfaces; the full truth depth has more.
+  const auto points = matched_bottom.at("points").get<double>();
+  EXPECT_LE(points, stereo_bottom.at("points").get<double>() * 1.01);
+  EXPECT_GT(points, stereo_bottom.at("points").get<double>() * 0.8);
+  EXPECT_LT(points, head(t, "bottom").at("points").get<double>());
+  const Json& on_surface = matched_bottom.at("points_vs_truth");
+  EXPECT_LT(on_surface.at("off_surface_3cm_fraction").get<double>(), 0.01) << on_surface.dump();
+  EXPECT_EQ(on_surface.at("on_sky_fraction").get<double>(), 0.0) << on_surface.dump();
+  EXPECT_GT(stereo_bottom.at("points_vs_truth").at("off_surface_3cm_fraction").get<double>(),
+            on_surface.at("off_surface_3cm_fraction").get<double>());
+}
+
 TEST(ProcessTruthDepthCli, ASessionWithoutTruthMapsIsRefusedNamingTheMissingFile) {
   ScopedTempDir dir("process_truth_depth_missing");
   const fs::path session = dir / "session";
@@ -118,6 +163,7 @@ TEST(ProcessTruthDepthCli, ASessionWithoutTruthMapsIsRefusedNamingTheMissingFile
       runFieldrig({"sim", "plots", "--out", session.string(), "--count", "1"}, dir.path());
   ASSERT_EQ(made.exit_code, 0) << made.err;
   for (const auto& extra : {std::vector<std::string>{"--depth-source", "truth"},
+                            std::vector<std::string>{"--depth-source", "truth-where-matched"},
                             std::vector<std::string>{"--score-stereo"}}) {
     std::vector<std::string> args = {"process", session.string(), "--out",
                                      (dir / "results").string()};

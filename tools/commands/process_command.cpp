@@ -81,9 +81,12 @@ int runProcess(const ProcessArgs& args) {
   if (args.depth_source == "truth") {
     options.cloud.depth_source = cloud::DepthSource::kTruth;
     run.truth_maps = daemon::TruthMaps::kDepth;
-  } else if (args.score_stereo) {
-    run.truth_maps = daemon::TruthMaps::kDepthAndVegetation;
+  } else if (args.depth_source == "truth-where-matched") {
+    options.cloud.depth_source = cloud::DepthSource::kTruthWhereMatched;
+    run.truth_maps = daemon::TruthMaps::kDepth;
   }
+  if (args.score_stereo)
+    run.truth_maps = daemon::TruthMaps::kDepthAndVegetation;
   if (args.depth_source == "truth" && args.score_stereo) {
     std::cerr << who << "--score-stereo scores stereo, which --depth-source truth does not run\n";
     return kExitBadInput;
@@ -163,11 +166,13 @@ void registerProcessCommand(CLI::App& app, int& exit_code) {
   process->add_flag("--clouds", args->clouds, "Also write each set's fused cloud as PLY");
   process
       ->add_option("--depth-source", args->depth_source,
-                   "Where each head's depth comes from: stereo (matching, the default) or truth "
+                   "Where each head's depth comes from: stereo (matching, the default), truth "
                    "(the left camera's rendered depth map that `fieldrig simulate` writes beside "
                    "each frame, through the same fusion, crop and traits; result lines say "
-                   "\"depth_source\": \"truth\")")
-      ->check(CLI::IsMember({"stereo", "truth"}));
+                   "\"depth_source\": \"truth\") or truth-where-matched (stereo runs, then its "
+                   "matched pixels take the truth's depth and the others none: what the pixels "
+                   "stereo leaves out cost, apart from its depth errors)")
+      ->check(CLI::IsMember({"stereo", "truth", "truth-where-matched"}));
   process->add_flag("--score-stereo", args->score_stereo,
                     "Score each head's stereo against the rendered truth depth (sessions of "
                     "`fieldrig simulate`): heads[].stereo_vs_truth in each result line, over "

@@ -5,7 +5,15 @@
 namespace fieldrig::cloud {
 
 const char* toString(DepthSource source) {
-  return source == DepthSource::kTruth ? "truth" : "stereo";
+  switch (source) {
+    case DepthSource::kTruth:
+      return "truth";
+    case DepthSource::kTruthWhereMatched:
+      return "truth-where-matched";
+    case DepthSource::kStereo:
+      break;
+  }
+  return "stereo";
 }
 
 core::Result<void> validate(const CloudOptions& options) {

@@ -154,7 +154,8 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
     try {
       const HeadFrames& head = frames[i];
       const bool truth_depth = options_.depth_source == DepthSource::kTruth;
-      if (truth_depth && head.left_truth_depth.empty()) {
+      const bool truth_where_matched = options_.depth_source == DepthSource::kTruthWhereMatched;
+      if ((truth_depth || truth_where_matched) && head.left_truth_depth.empty()) {
         status.problem = status.name + ": no truth depth map for the left camera";
         return;
       }
@@ -169,16 +170,24 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
       }
       measureCoverage(output->disparity, status);
       std::optional<cv::Mat> truth_disparity;
-      if (!truth_depth && !head.left_truth_depth.empty() && !head.left_truth_vegetation.empty()) {
+      if (!truth_depth && !head.left_truth_depth.empty()) {
         const stereo::TruthDepthRectifier& truth = heads_[i].truthDepth();
         core::Result<cv::Mat> disparity = truth.disparity(head.left_truth_depth);
-        core::Result<cv::Mat> vegetation = truth.rectifyMask(head.left_truth_vegetation);
-        if (disparity && vegetation) {
-          status.stereo_score = truth.score(output->disparity, *disparity, *vegetation,
-                                            options_.min_depth_m, options_.max_depth_m);
+        if (disparity && !head.left_truth_vegetation.empty()) {
+          if (core::Result<cv::Mat> vegetation = truth.rectifyMask(head.left_truth_vegetation))
+            status.stereo_score = truth.score(output->disparity, *disparity, *vegetation,
+                                              options_.min_depth_m, options_.max_depth_m);
+        }
+        if (disparity) {
           truth_disparity = std::move(*disparity);
+        } else if (truth_where_matched) {
+          status.problem = disparity.error().message;
+          return;
         }
       }
+      // The stereo score above stays the matcher's; everything after sees the truth's depth.
+      if (truth_where_matched)
+        output->disparity = stereo::truthWhereMatched(output->disparity, *truth_disparity);
       if (options_.edge_max_jump_px > 0)
         status.edge_pixels = dropDepthEdges(output->disparity, options_.edge_max_jump_px,
                                             options_.edge_keep_near_side);

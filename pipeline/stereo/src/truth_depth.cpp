@@ -190,4 +190,19 @@ CloudTruthScore TruthDepthRectifier::scoreCloud(const cv::Mat& measured, const c
   return out;
 }
 
+cv::Mat truthWhereMatched(const cv::Mat& measured, const cv::Mat& truth) {
+  CV_Assert(measured.type() == CV_32F && truth.type() == CV_32F && measured.size() == truth.size());
+  cv::Mat out(measured.size(), CV_32F, cv::Scalar(kInvalidDisparity));
+  for (int v = 0; v < measured.rows; ++v) {
+    const auto* m = measured.ptr<float>(v);
+    const auto* t = truth.ptr<float>(v);
+    auto* o = out.ptr<float>(v);
+    for (int u = 0; u < measured.cols; ++u) {
+      if (m[u] >= 0 && t[u] >= 0)
+        o[u] = t[u];
+    }
+  }
+  return out;
+}
+
 }  // namespace fieldrig::stereo

@@ -13,8 +13,11 @@ namespace fieldrig::cloud {
 // Where each head's depth comes from: its stereo pair (always, on the rig), or the simulator's
 // rendered truth depth of its left camera (stereo/truth_depth.h), which runs the same chain after
 // matching on perfect disparities: `fieldrig process --depth-source truth`, to tell what stereo
-// costs from what fusion, crop and traits cost. Not a configuration key: no real camera has it.
-enum class DepthSource { kStereo, kTruth };
+// costs from what fusion, crop and traits cost. kTruthWhereMatched runs stereo and then puts the
+// truth's disparity on exactly the pixels stereo matched (none elsewhere): stereo's coverage with
+// no depth error, which splits what stereo costs into the pixels it leaves out and the depth it
+// gets wrong. Not a configuration key: no real camera has it.
+enum class DepthSource { kStereo, kTruth, kTruthWhereMatched };
 
 const char* toString(DepthSource source);
 

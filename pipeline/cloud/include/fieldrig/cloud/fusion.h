@@ -24,9 +24,9 @@ using Cloud = pcl::PointCloud<pcl::PointXYZRGB>;
 
 // One head's frames: raw Bayer (CV_8UC1, of `pixel_format`) or BGR images; empty = missing.
 // The simulator's truth of the left camera may come along (sim/field's maps, camera size):
-// `left_truth_depth` (CV_32F, z in metres) is the depth with DepthSource::kTruth; with kStereo,
-// it and `left_truth_vegetation` (8-bit mask) score the matched disparity
-// (HeadStatus::stereo_score).
+// `left_truth_depth` (CV_32F, z in metres) is the depth with DepthSource::kTruth and, on the
+// pixels stereo matched, with kTruthWhereMatched; with stereo running, it and
+// `left_truth_vegetation` (8-bit mask) score the matched disparity (HeadStatus::stereo_score).
 struct HeadFrames {
   cv::Mat left, right;
   core::PixelFormat pixel_format = core::PixelFormat::kBayerRG8;

@@ -72,4 +72,9 @@ class TruthDepthRectifier {
   cv::Matx44d q_;
 };
 
+// The truth's disparity on exactly the pixels where `measured` has one (both CV_32F disparities
+// at matching size), kInvalidDisparity elsewhere and where the truth has none: a matcher's
+// coverage without its depth errors.
+cv::Mat truthWhereMatched(const cv::Mat& measured, const cv::Mat& truth);
+
 }  // namespace fieldrig::stereo
