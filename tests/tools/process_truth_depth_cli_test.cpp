@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "support/cli_run.h"
 #include "support/temp_dir.h"
@@ -38,24 +39,33 @@ const Json& head(const Json& line, const std::string& name) {
   return none;
 }
 
-TEST(ProcessTruthDepthCli, TruthDepthGoesThroughTheSameChainAndStereoIsScoredAgainstIt) {
-  ScopedTempDir dir("process_truth_depth");
+// A rendered one-plot session (mesh renderer, so with truth maps) in DIR/session.
+fs::path renderedSession(const ScopedTempDir& dir) {
   const fs::path session = dir / "session";
   const auto made = runFieldrig(
       {"sim", "plots", "--out", session.string(), "--count", "1", "--stage", "mid"}, dir.path());
-  ASSERT_EQ(made.exit_code, 0) << made.err;
+  EXPECT_EQ(made.exit_code, 0) << made.err;
+  return session;
+}
+
+// `fieldrig process SESSION --out DIR/NAME EXTRA...`: its one result line (null when it failed).
+Json processedLine(const ScopedTempDir& dir, const fs::path& session, const std::string& name,
+                   const std::vector<std::string>& extra) {
+  std::vector<std::string> args = {"process", session.string(), "--out", (dir / name).string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  const auto run = runFieldrig(args, dir.path());
+  EXPECT_EQ(run.exit_code, 0) << name << ": " << run.err;
+  return run.exit_code == 0 ? plotLine(run) : Json();
+}
+
+TEST(ProcessTruthDepthCli, TruthDepthGoesThroughTheSameChainAndStereoIsScoredAgainstIt) {
+  ScopedTempDir dir("process_truth_depth");
+  const fs::path session = renderedSession(dir);
+  ASSERT_FALSE(HasFailure());
   const Json truth = Json::parse(readWholeFile(session / "truth.jsonl"));
 
-  const auto stereo = runFieldrig(
-      {"process", session.string(), "--out", (dir / "stereo").string(), "--score-stereo"},
-      dir.path());
-  ASSERT_EQ(stereo.exit_code, 0) << stereo.err;
-  const auto from_truth = runFieldrig(
-      {"process", session.string(), "--out", (dir / "truth").string(), "--depth-source", "truth"},
-      dir.path());
-  ASSERT_EQ(from_truth.exit_code, 0) << from_truth.err;
-  const Json s = plotLine(stereo);
-  const Json t = plotLine(from_truth);
+  const Json s = processedLine(dir, session, "stereo", {"--score-stereo"});
+  const Json t = processedLine(dir, session, "truth", {"--depth-source", "truth"});
   ASSERT_FALSE(s.is_null());
   ASSERT_FALSE(t.is_null());
   EXPECT_FALSE(s.contains("depth_source")) << "a stereo line stays as the rig writes it";
@@ -113,26 +123,12 @@ TEST(ProcessTruthDepthCli, TruthDepthGoesThroughTheSameChainAndStereoIsScoredAga
 
 TEST(ProcessTruthDepthCli, TruthWhereMatchedKeepsStereosPixelsWithTheTruthsDepth) {
   ScopedTempDir dir("process_truth_where_matched");
-  const fs::path session = dir / "session";
-  const auto made = runFieldrig(
-      {"sim", "plots", "--out", session.string(), "--count", "1", "--stage", "mid"}, dir.path());
-  ASSERT_EQ(made.exit_code, 0) << made.err;
-  const auto stereo = runFieldrig(
-      {"process", session.string(), "--out", (dir / "stereo").string(), "--score-stereo"},
-      dir.path());
-  ASSERT_EQ(stereo.exit_code, 0) << stereo.err;
-  const auto matched =
-      runFieldrig({"process", session.string(), "--out", (dir / "matched").string(),
-                   "--depth-source", "truth-where-matched", "--score-stereo"},
-                  dir.path());
-  ASSERT_EQ(matched.exit_code, 0) << matched.err;
-  const auto from_truth = runFieldrig(
-      {"process", session.string(), "--out", (dir / "truth").string(), "--depth-source", "truth"},
-      dir.path());
-  ASSERT_EQ(from_truth.exit_code, 0) << from_truth.err;
-  const Json s = plotLine(stereo);
-  const Json m = plotLine(matched);
-  const Json t = plotLine(from_truth);
+  const fs::path session = renderedSession(dir);
+  ASSERT_FALSE(HasFailure());
+  const Json s = processedLine(dir, session, "stereo", {"--score-stereo"});
+  const Json m = processedLine(dir, session, "matched",
+                               {"--depth-source", "truth-where-matched", "--score-stereo"});
+  const Json t = processedLine(dir, session, "truth", {"--depth-source", "truth"});
   ASSERT_FALSE(s.is_null() || m.is_null() || t.is_null());
   EXPECT_EQ(m.at("depth_source"), "truth-where-matched");
   EXPECT_EQ(m.at("traits").at("status"), "ok") << m.dump();
