@@ -304,6 +304,8 @@ void readMatcher(const Value& section, stereo::MatcherOptions& o) {
               {"match_colour", flag(o.match_colour)},
               {"full_width", flag(o.full_width)},
               {"min_texture", numberIn(o.min_texture, 0, stereo::kMaxMinTexture)},
+              {"grow_uniqueness_ratio", integer(o.grow_uniqueness_ratio, -1, 100)},
+              {"grow_confirmed_fraction", numberIn(o.grow_confirmed_fraction, 0, 1)},
           });
   // The library's own ranges (and those across keys), so the file and the command line agree.
   if (auto valid = stereo::validate(o); !valid)

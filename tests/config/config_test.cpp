@@ -96,6 +96,8 @@ void expectSame(const stereo::MatcherOptions& actual, const stereo::MatcherOptio
   EXPECT_FIELD(match_colour);
   EXPECT_FIELD(full_width);
   EXPECT_FIELD(min_texture);
+  EXPECT_FIELD(grow_uniqueness_ratio);
+  EXPECT_FIELD(grow_confirmed_fraction);
 }
 
 void expectSame(const cloud::CloudOptions& actual, const cloud::CloudOptions& expected) {
@@ -364,6 +366,18 @@ TEST_F(ConfigErrors, OutOfRangeValuesAreRefused) {
   expectError("pipeline:\n  matcher:\n    mode: bm\n", 3, "pipeline.matcher.mode",
               "'bm' is not one of sgbm, hh, sgbm_3way or hh4");
   expectError("log:\n  level: verbose\n", 2, "log.level", "'verbose' is not one of trace");
+  expectError("pipeline:\n  matcher:\n    wls: true\n    grow_uniqueness_ratio: 0\n", 3,
+              "pipeline.matcher", "grow_uniqueness_ratio needs wls off");
+}
+
+// The grow keys cannot join EveryKeyReachesItsField's matcher: it turns WLS on, which they refuse.
+TEST(ConfigSections, MatcherGrowKeysReachTheirFields) {
+  const core::Result<Config> config = parseConfig(
+      "pipeline:\n  matcher: {grow_uniqueness_ratio: 3, grow_confirmed_fraction: 0.25}\n", "inline",
+      "/");
+  ASSERT_TRUE(config.ok()) << config.error().message;
+  EXPECT_EQ(config->pipeline.cloud.matcher.grow_uniqueness_ratio, 3);
+  EXPECT_DOUBLE_EQ(config->pipeline.cloud.matcher.grow_confirmed_fraction, 0.25);
 }
 
 // One policy for numbers (issue 17): finite, and bounded above as well as below, so that a typo

@@ -83,6 +83,16 @@ TEST(StereoCli, DisparityOfTeddyMatchesGroundTruth) {
   EXPECT_NEAR(Json::parse(run.out_lines.at(0))["valid_fraction"].get<double>(),
               static_cast<double>(cv::countNonZero(*map >= 0)) / static_cast<double>(map->total()),
               1e-9);
+
+  // The flag reaches the matcher: growing from a second matching leaves more pixels matched.
+  const auto grown =
+      runFieldrig({"disparity", "--left", kData + "middlebury2003/teddy/im2.png", "--right",
+                   kData + "middlebury2003/teddy/im6.png", "--num-disparities", "64",
+                   "--grow-uniqueness-ratio", "0", "--out", (dir / "grown.pfm").string()},
+                  dir.path());
+  ASSERT_EQ(grown.exit_code, 0) << grown.err;
+  EXPECT_GT(Json::parse(grown.out_lines.at(0))["valid_fraction"].get<double>(),
+            Json::parse(run.out_lines.at(0))["valid_fraction"].get<double>());
 }
 
 TEST(StereoCli, BadInputIsAClearError) {
@@ -224,6 +234,8 @@ TEST(StereoCli, UnusableCalibrationAndOptionsNameTheCulprit) {
        "--num-disparities 0 is outside the allowed range [16, 1024] (a multiple of 16)"},
       {{"--block-size", "9999"}, "--block-size 9999 is outside the allowed range [1, 31] (odd)"},
       {{"--block-size", "4"}, "--block-size 4 is outside the allowed range [1, 31] (odd)"},
+      {{"--grow-uniqueness-ratio", "-2"},
+       "--grow-uniqueness-ratio -2 is outside the allowed range [-1, 100] (-1 disables it)"},
       // 640-pixel-wide images: SGBM aborted on an empty buffer.
       {{"--num-disparities", "640"},
        "--num-disparities 640 leaves no column of the 640-pixel-wide images to match: at most 624"},

@@ -21,6 +21,7 @@ struct DisparityArgs {
   int block_size = 5;
   bool wls = false;
   bool lr_check = false;
+  int grow_uniqueness_ratio = -1;
 };
 
 int runDisparity(const DisparityArgs& args) {
@@ -45,6 +46,7 @@ int runDisparity(const DisparityArgs& args) {
   options.block_size = args.block_size;
   options.wls = args.wls;
   options.lr_check = args.lr_check;
+  options.grow_uniqueness_ratio = args.grow_uniqueness_ratio;
   if (auto valid = stereo::validate(options, left.size(), stereo::OptionNames::kCommandLineFlags);
       !valid)
     return fail(who, valid.error().message);
@@ -98,6 +100,10 @@ void registerDisparityCommand(CLI::App& app, int& exit_code) {
   cmd->add_flag("--wls", args->wls, "Apply opencv_contrib's WLS filter (fills holes)");
   cmd->add_flag("--lr-check", args->lr_check,
                 "Match the right view too and drop inconsistent pixels");
+  cmd->add_option("--grow-uniqueness-ratio", args->grow_uniqueness_ratio,
+                  "Match again at this uniqueness ratio and keep its matches in the first's "
+                  "holes where their piece of disparity is confirmed by the first (-1: off)")
+      ->capture_default_str();
   cmd->add_option("--out", args->out, "Output .pfm")->required();
 }
 

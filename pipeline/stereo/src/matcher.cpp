@@ -4,11 +4,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 namespace fieldrig::stereo {
 namespace {
@@ -107,6 +109,16 @@ core::Result<void> validate(const MatcherOptions& options, OptionNames names) {
     return outside("wls_lambda", options.wls_lambda, "[0, ...), finite");
   if (!(options.wls_sigma > 0 && std::isfinite(options.wls_sigma)))
     return outside("wls_sigma", options.wls_sigma, "(0, ...), finite");
+  if (options.grow_uniqueness_ratio < -1 || options.grow_uniqueness_ratio > 100) {
+    return outside("grow_uniqueness_ratio", options.grow_uniqueness_ratio,
+                   range(-1, 100) + " (-1 disables it)");
+  }
+  if (!(options.grow_confirmed_fraction >= 0 && options.grow_confirmed_fraction < 1))
+    return outside("grow_confirmed_fraction", options.grow_confirmed_fraction, "[0, 1)");
+  if (options.grow_uniqueness_ratio >= 0 && options.wls) {
+    return Error{optionName("grow_uniqueness_ratio", names) +
+                 " needs wls off (WLS fills every pixel, so there is nothing to grow into)"};
+  }
   if (!(options.min_texture >= 0 && options.min_texture <= kMaxMinTexture))
     return outside("min_texture", options.min_texture, range(0, kMaxMinTexture));
   if (options.mode != cv::StereoSGBM::MODE_SGBM && options.mode != cv::StereoSGBM::MODE_HH &&
@@ -150,6 +162,70 @@ cv::Mat toFloatDisparity(const cv::Mat& fixed_point, int min_disparity) {
   return out;
 }
 
+cv::Mat growConfirmedPieces(const cv::Mat& confident, const cv::Mat& ambiguous, float piece_range,
+                            double min_confirmed_fraction) {
+  CV_Assert(confident.type() == CV_32F && ambiguous.type() == CV_32F &&
+            confident.size() == ambiguous.size());
+  constexpr float kConfirmedWithin = 1.0f;
+  const int width = ambiguous.cols;
+  const int height = ambiguous.rows;
+  // Pieces are labelled by a flood fill: OpenCV's connectedComponents joins pixels by a binary
+  // mask only, and filterSpeckles (the same pieces) removes them without saying which is which.
+  std::vector<int> piece(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1);
+  std::vector<int> stack;
+  int pieces = 0;
+  cv::Mat out = confident.clone();
+  std::vector<int> members;
+  for (int start = 0; start < width * height; ++start) {
+    const int start_x = start % width;
+    const int start_y = start / width;
+    if (piece[static_cast<std::size_t>(start)] >= 0 || ambiguous.at<float>(start_y, start_x) < 0) {
+      continue;
+    }
+    const int label = pieces++;
+    members.clear();
+    stack.assign(1, start);
+    piece[static_cast<std::size_t>(start)] = label;
+    std::size_t confirmed = 0;
+    while (!stack.empty()) {
+      const int index = stack.back();
+      stack.pop_back();
+      members.push_back(index);
+      const int x = index % width;
+      const int y = index / width;
+      const float d = ambiguous.at<float>(y, x);
+      const float c = confident.at<float>(y, x);
+      if (c >= 0 && std::fabs(c - d) <= kConfirmedWithin)
+        ++confirmed;
+      const auto visit = [&](int nx, int ny) {
+        if (nx < 0 || ny < 0 || nx >= width || ny >= height)
+          return;
+        const int next = ny * width + nx;
+        const float nd = ambiguous.at<float>(ny, nx);
+        if (piece[static_cast<std::size_t>(next)] >= 0 || nd < 0 || std::fabs(nd - d) > piece_range)
+          return;
+        piece[static_cast<std::size_t>(next)] = label;
+        stack.push_back(next);
+      };
+      visit(x - 1, y);
+      visit(x + 1, y);
+      visit(x, y - 1);
+      visit(x, y + 1);
+    }
+    const bool kept =
+        confirmed > 0 && static_cast<double>(confirmed) >
+                             min_confirmed_fraction * static_cast<double>(members.size());
+    if (!kept)
+      continue;
+    for (const int index : members) {
+      float& o = out.at<float>(index / width, index % width);
+      if (o < 0)
+        o = ambiguous.at<float>(index / width, index % width);
+    }
+  }
+  return out;
+}
+
 void leftRightCheck(cv::Mat& left_disparity, const cv::Mat& right_disparity, float max_diff) {
   CV_Assert(left_disparity.type() == CV_32F && right_disparity.type() == CV_32F &&
             left_disparity.size() == right_disparity.size());
@@ -170,13 +246,21 @@ void leftRightCheck(cv::Mat& left_disparity, const cv::Mat& right_disparity, flo
 DisparityMatcher::DisparityMatcher(const MatcherOptions& options) : options_(options) {
   const int channels = options_.match_colour ? 3 : 1;
   const int area = options_.block_size * options_.block_size;
-  left_matcher_ = cv::StereoSGBM::create(
-      options_.min_disparity, options_.num_disparities, options_.block_size,
-      options_.p1_per_pixel * channels * area, options_.p2_per_pixel * channels * area,
-      options_.disp12_max_diff, options_.pre_filter_cap, options_.uniqueness_ratio,
-      options_.speckle_window, options_.speckle_range, options_.mode);
+  const auto sgbm = [&](int uniqueness_ratio) {
+    return cv::StereoSGBM::create(options_.min_disparity, options_.num_disparities,
+                                  options_.block_size, options_.p1_per_pixel * channels * area,
+                                  options_.p2_per_pixel * channels * area, options_.disp12_max_diff,
+                                  options_.pre_filter_cap, uniqueness_ratio,
+                                  options_.speckle_window, options_.speckle_range, options_.mode);
+  };
+  left_matcher_ = sgbm(options_.uniqueness_ratio);
   if (options_.lr_check || options_.wls) {
     right_matcher_ = cv::ximgproc::createRightMatcher(left_matcher_);
+  }
+  if (options_.grow_uniqueness_ratio >= 0) {
+    grow_left_matcher_ = sgbm(options_.grow_uniqueness_ratio);
+    if (options_.lr_check)
+      grow_right_matcher_ = cv::ximgproc::createRightMatcher(grow_left_matcher_);
   }
   if (options_.wls) {
     wls_ = cv::ximgproc::createDisparityWLSFilter(left_matcher_);
@@ -210,6 +294,13 @@ cv::Mat DisparityMatcher::compute(const cv::Mat& left, const cv::Mat& right,
   if (right_matcher_) {
     right_matcher_->compute(right_in, left_in, right_fixed);
   }
+  cv::Mat grow_left_fixed;
+  cv::Mat grow_right_fixed;
+  if (grow_left_matcher_) {
+    grow_left_matcher_->compute(left_in, right_in, grow_left_fixed);
+    if (grow_right_matcher_)
+      grow_right_matcher_->compute(right_in, left_in, grow_right_fixed);
+  }
   if (timings)
     timings->sgbm_ms = core::millisecondsSince(start);
   start = Clock::now();
@@ -222,6 +313,16 @@ cv::Mat DisparityMatcher::compute(const cv::Mat& left, const cv::Mat& right,
     disparity = toFloatDisparity(left_fixed, options_.min_disparity);
     if (options_.lr_check) {
       leftRightCheck(disparity, rightViewToFloat(right_fixed, options_), options_.lr_max_diff);
+    }
+    if (grow_left_matcher_) {
+      cv::Mat ambiguous = toFloatDisparity(grow_left_fixed, options_.min_disparity);
+      if (grow_right_matcher_) {
+        leftRightCheck(ambiguous, rightViewToFloat(grow_right_fixed, options_),
+                       options_.lr_max_diff);
+      }
+      disparity =
+          growConfirmedPieces(disparity, ambiguous, static_cast<float>(options_.speckle_range),
+                              options_.grow_confirmed_fraction);
     }
   }
   if (pad_left > 0 || pad_right > 0) {

@@ -171,3 +171,60 @@ TEST(MinTexture, OutOfRangeIsAnErrorNamingIt) {
 
 }  // namespace
 }  // namespace fieldrig::stereo
+
+namespace fieldrig::stereo {
+namespace {
+
+// grow_uniqueness_ratio on real pairs with ground truth: every pixel the shipped matcher gives
+// keeps its disparity, more pixels get one, and the pixels it adds are right at least as often
+// as those that simply lowering uniqueness_ratio adds (its point: the ambiguous matches kept
+// are those in pieces the confident ones confirm).
+class GrowAccuracy : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(GrowAccuracy, KeepsTheConfidentMatchesAndAddsBetterOnesThanLowerUniqueness) {
+  const Scene scene = loadScene(GetParam());
+  ASSERT_FALSE(scene.left.empty());
+  MatcherOptions options;
+  options.num_disparities = scene.num_disparities;
+  const cv::Mat shipped = DisparityMatcher(options).compute(scene.left, scene.right);
+  MatcherOptions grow_options = options;
+  grow_options.grow_uniqueness_ratio = 0;
+  const cv::Mat grown = DisparityMatcher(grow_options).compute(scene.left, scene.right);
+  MatcherOptions low_options = options;
+  low_options.uniqueness_ratio = 0;
+  const cv::Mat low = DisparityMatcher(low_options).compute(scene.left, scene.right);
+  int changed = 0;
+  int added_grow = 0, bad_grow = 0, added_low = 0, bad_low = 0;
+  for (int y = 0; y < shipped.rows; ++y) {
+    for (int x = 0; x < shipped.cols; ++x) {
+      const float s = shipped.at<float>(y, x);
+      const float truth = scene.truth.at<float>(y, x);
+      if (s >= 0) {
+        changed += grown.at<float>(y, x) != s ? 1 : 0;
+        continue;
+      }
+      if (truth <= 0)
+        continue;
+      if (grown.at<float>(y, x) >= 0) {
+        ++added_grow;
+        bad_grow += std::abs(grown.at<float>(y, x) - truth) > 2.0f ? 1 : 0;
+      }
+      if (low.at<float>(y, x) >= 0) {
+        ++added_low;
+        bad_low += std::abs(low.at<float>(y, x) - truth) > 2.0f ? 1 : 0;
+      }
+    }
+  }
+  std::printf("%s: grow adds %d (bad-2 %.3f), uniqueness 0 adds %d (bad-2 %.3f)\n",
+              GetParam().c_str(), added_grow, added_grow ? 1.0 * bad_grow / added_grow : 0.0,
+              added_low, added_low ? 1.0 * bad_low / added_low : 0.0);
+  EXPECT_EQ(changed, 0);
+  EXPECT_GT(added_grow, 0);
+  ASSERT_GT(added_low, 0);
+  EXPECT_LE(1.0 * bad_grow / added_grow, 1.0 * bad_low / added_low);
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, GrowAccuracy, ::testing::Values("teddy", "cones", "aloe"));
+
+}  // namespace
+}  // namespace fieldrig::stereo

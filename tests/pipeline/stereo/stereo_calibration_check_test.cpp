@@ -312,6 +312,18 @@ TEST(MatcherOptionsCheck, EachOutOfRangeOptionIsNamedWithItsRange) {
                       "lr_max_diff nan is outside the allowed range [0, ...) pixels, finite");
   expectOptionRefused([](auto& o) { o.wls_sigma = 0; },
                       "wls_sigma 0 is outside the allowed range (0, ...), finite");
+  expectOptionRefused([](auto& o) { o.grow_uniqueness_ratio = -2; },
+                      "grow_uniqueness_ratio -2 is outside the allowed range [-1, 100] (-1 "
+                      "disables it)");
+  expectOptionRefused([](auto& o) { o.grow_confirmed_fraction = 1.0; },
+                      "grow_confirmed_fraction 1 is outside the allowed range [0, 1)");
+  expectOptionRefused(
+      [](auto& o) {
+        o.grow_uniqueness_ratio = 0;
+        o.wls = true;
+      },
+      "grow_uniqueness_ratio needs wls off (WLS fills every pixel, so there is nothing to grow "
+      "into)");
   expectOptionRefused([](auto& o) { o.mode = 7; },
                       "mode 7 is outside the allowed range (sgbm, hh, sgbm_3way or hh4)");
 }

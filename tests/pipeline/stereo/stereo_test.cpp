@@ -60,6 +60,39 @@ TEST(LeftRightCheck, KeepsConsistentAndDropsInconsistentPixels) {
   EXPECT_FLOAT_EQ(left.at<float>(0, 1), kInvalidDisparity);
 }
 
+// Two pieces of the ambiguous map fill the confident map's holes: the one the confident map
+// agrees with somewhere is added, the one it never confirms (a mismatched blob) is not; where
+// the confident map has a disparity, it stays.
+TEST(GrowConfirmedPieces, AddsOnlyPiecesTheConfidentMapConfirms) {
+  cv::Mat confident(2, 8, CV_32F, cv::Scalar(kInvalidDisparity));
+  cv::Mat ambiguous(2, 8, CV_32F, cv::Scalar(kInvalidDisparity));
+  // Piece A, columns 0-3 of both rows, a slope of 10..11.5: confirmed at (0, 0) only.
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x)
+      ambiguous.at<float>(y, x) = 10.0f + 0.5f * static_cast<float>(x);
+  confident.at<float>(0, 0) = 10.4f;
+  confident.at<float>(1, 1) = 20.0f;  // disagrees: keeps its own value
+  // Piece B, columns 5-7: 40 px, a jump of 28 from A's end; the confident map is 3 px off it.
+  for (int y = 0; y < 2; ++y)
+    for (int x = 5; x < 8; ++x)
+      ambiguous.at<float>(y, x) = 40.0f;
+  confident.at<float>(0, 6) = 43.0f;
+
+  const cv::Mat grown = growConfirmedPieces(confident, ambiguous, 2.0f, 0.0);
+  EXPECT_FLOAT_EQ(grown.at<float>(0, 0), 10.4f);
+  EXPECT_FLOAT_EQ(grown.at<float>(1, 1), 20.0f);
+  EXPECT_FLOAT_EQ(grown.at<float>(0, 3), 11.5f);
+  EXPECT_FLOAT_EQ(grown.at<float>(1, 2), 11.0f);
+  EXPECT_FLOAT_EQ(grown.at<float>(0, 4), kInvalidDisparity);  // in neither map
+  EXPECT_FLOAT_EQ(grown.at<float>(0, 6), 43.0f);
+  EXPECT_FLOAT_EQ(grown.at<float>(1, 5), kInvalidDisparity);  // piece B: never confirmed
+
+  // One confirmed pixel of A's eight is not more than half of them.
+  const cv::Mat strict = growConfirmedPieces(confident, ambiguous, 2.0f, 0.5);
+  EXPECT_FLOAT_EQ(strict.at<float>(0, 3), kInvalidDisparity);
+  EXPECT_FLOAT_EQ(strict.at<float>(0, 0), 10.4f);
+}
+
 TEST(Scoring, CountsHandMadeFixture) {
   // Truth: 4 known pixels, one unknown (0). Estimates: exact, 1.5 off, 3 off, invalid.
   const cv::Mat truth = (cv::Mat_<float>(1, 5) << 10, 10, 10, 10, 0);

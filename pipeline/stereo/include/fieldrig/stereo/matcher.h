@@ -48,6 +48,14 @@ struct MatcherOptions {
   // them. 2 measured best on the rendered mesh field (24 plots, three stages): sky points had
   // put plots' heights up to 67 cm high; 4 kept less of the plants.
   double min_texture = 2.0;
+  // -1: off. Otherwise a second matching at this uniqueness ratio (below uniqueness_ratio: more
+  // matches, some ambiguous) adds the pixels the first left without disparity, but only those
+  // in a piece of the second's disparity (neighbours within speckle_range) that the first
+  // confirms: at least grow_confirmed_fraction of the piece's pixels match the first within
+  // 1 px. Far-side leaves seen through gaps are ambiguous at the shipped ratio yet lie in pieces
+  // the first partly matches; mismatched blobs do not.
+  int grow_uniqueness_ratio = -1;
+  double grow_confirmed_fraction = 0.0;
 };
 
 // The ranges validate() enforces, each with its reason:
@@ -101,6 +109,9 @@ class DisparityMatcher {
   MatcherOptions options_;
   cv::Ptr<cv::StereoSGBM> left_matcher_;
   cv::Ptr<cv::StereoMatcher> right_matcher_;
+  // grow_uniqueness_ratio's second matcher (and its right view for lr_check), else null.
+  cv::Ptr<cv::StereoSGBM> grow_left_matcher_;
+  cv::Ptr<cv::StereoMatcher> grow_right_matcher_;
   cv::Ptr<cv::ximgproc::DisparityWLSFilter> wls_;
 };
 
@@ -112,6 +123,13 @@ cv::Mat computeDefaultSgbm(const cv::Mat& left, const cv::Mat& right, int num_di
 
 // Keeps pixels of `left_disparity` whose match in `right_disparity` (right view, positive
 // pixels, kInvalidDisparity = none) lies within `max_diff`; the others become invalid.
+// The disparity of `confident` where valid; elsewhere that of `ambiguous` where the pixel belongs
+// to a piece of `ambiguous` (4-connected pixels whose disparities differ by at most
+// `piece_range`) of which more than `min_confirmed_fraction` of the pixels (and at least one)
+// have a valid `confident` disparity within 1 px of their own. Both CV_32F, same size.
+cv::Mat growConfirmedPieces(const cv::Mat& confident, const cv::Mat& ambiguous, float piece_range,
+                            double min_confirmed_fraction);
+
 void leftRightCheck(cv::Mat& left_disparity, const cv::Mat& right_disparity, float max_diff);
 
 // Makes invalid the pixels of `disparity` whose grey level in `image` (same size, grey or BGR)
