@@ -206,18 +206,22 @@ def main():
     print("\nPer head, stereo against the per-pixel truth (vegetation pixels inside the depth crop; "
           "bad = |disparity error| > 2 px at matching resolution, of the matched pixels); "
           "points in the fused cloud, and of stereo's points those > 3 cm off the truth surface "
-          "on their ray (or on sky), with the worst plot's share")
+          "on their ray (or on sky), with the worst plot's share; the off points nearer and "
+          "farther than the truth on their own ray, and the nearer ones whose truth lies beyond "
+          "the depth crop")
     print("| head | plots seen | vegetation px | matched | bad | median abs depth error | "
           "median depth error | points (b) | points (c) | (c) off surface | worst plot | "
-          "on sky |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+          "on sky | nearer | farther | from beyond the crop |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- "
+          "| --- |")
     heads = {}
     for p in plots:
         for head in from_stereo.get(p, {}).get("heads", []):
             h = heads.setdefault(head["name"], {"plots": 0, "pixels": 0, "matched": 0.0,
                                                 "bad": 0.0, "abs": [], "signed": [],
                                                 "points_b": 0, "points_c": 0, "scored": 0,
-                                                "off": 0.0, "sky": 0.0, "off_worst": 0.0})
+                                                "off": 0.0, "sky": 0.0, "off_worst": 0.0,
+                                                "nearer": 0.0, "farther": 0.0, "beyond": 0.0})
             h["points_c"] += head.get("points", 0)
             cloud_score = head.get("points_vs_truth")
             if cloud_score and cloud_score["points"]:
@@ -225,6 +229,10 @@ def main():
                 h["scored"] += n
                 h["off"] += cloud_score["off_surface_3cm_fraction"] * n
                 h["sky"] += cloud_score["on_sky_fraction"] * n
+                # Sessions processed before the side of the truth was scored have no such keys.
+                h["nearer"] += cloud_score.get("off_nearer_fraction", 0.0) * n
+                h["farther"] += cloud_score.get("off_farther_fraction", 0.0) * n
+                h["beyond"] += cloud_score.get("from_beyond_crop_fraction", 0.0) * n
                 h["off_worst"] = max(h["off_worst"], cloud_score["off_surface_3cm_fraction"])
             score = head.get("stereo_vs_truth")
             if not score or not score["vegetation_pixels"]:
@@ -247,17 +255,22 @@ def main():
         med = statistics.median(h["signed"]) if h["signed"] else 0.0
         off = h["off"] / h["scored"] if h["scored"] else 0.0
         sky = h["sky"] / h["scored"] if h["scored"] else 0.0
+        nearer, farther, beyond = (h[k] / h["scored"] if h["scored"] else 0.0
+                                   for k in ("nearer", "farther", "beyond"))
         summary["heads"][name] = {"plots": h["plots"], "vegetation_pixels": h["pixels"],
                                   "matched_fraction": matched, "bad_fraction": bad,
                                   "median_abs_depth_error_m": med_abs,
                                   "median_depth_error_m": med, "points_truth_depth": h["points_b"],
                                   "points_stereo": h["points_c"], "off_surface_3cm_fraction": off,
                                   "off_surface_worst_plot": h["off_worst"],
-                                  "on_sky_fraction": sky}
+                                  "on_sky_fraction": sky, "off_nearer_fraction": nearer,
+                                  "off_farther_fraction": farther,
+                                  "from_beyond_crop_fraction": beyond}
         print(f"| {name} | {h['plots']} | {h['pixels']} | {100 * matched:.1f} % | "
               f"{100 * bad:.1f} % | {1000 * med_abs:.1f} mm | {1000 * med:+.1f} mm | "
               f"{h['points_b']} | {h['points_c']} | {100 * off:.1f} % | "
-              f"{100 * h['off_worst']:.1f} % | {100 * sky:.2f} % |")
+              f"{100 * h['off_worst']:.1f} % | {100 * sky:.2f} % | {100 * nearer:.1f} % | "
+              f"{100 * farther:.1f} % | {100 * beyond:.1f} % |")
     print("(depth errors: the median over plots of each plot's median)")
     print(json.dumps({"summary": summary}))
 

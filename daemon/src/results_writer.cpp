@@ -81,7 +81,10 @@ nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::Pl
       head_json["points_vs_truth"] = {
           {"points", head.cloud_score->points},
           {"off_surface_3cm_fraction", head.cloud_score->off_surface_fraction},
-          {"on_sky_fraction", head.cloud_score->on_sky_fraction}};
+          {"on_sky_fraction", head.cloud_score->on_sky_fraction},
+          {"off_nearer_fraction", head.cloud_score->off_nearer_fraction},
+          {"off_farther_fraction", head.cloud_score->off_farther_fraction},
+          {"from_beyond_crop_fraction", head.cloud_score->from_beyond_crop_fraction}};
     }
     heads.push_back(std::move(head_json));
   }

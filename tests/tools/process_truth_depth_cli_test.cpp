@@ -118,6 +118,14 @@ TEST(ProcessTruthDepthCli, TruthDepthGoesThroughTheSameChainAndStereoIsScoredAga
   const double off = points.at("off_surface_3cm_fraction").get<double>();
   EXPECT_GE(off, points.at("on_sky_fraction").get<double>()) << points.dump();
   EXPECT_LT(off, 0.25) << points.dump();
+  // The off points by side: those with a side and those on sky are apart, and none is counted
+  // twice; the ones from beyond the crop are some of the nearer ones.
+  const double nearer = points.at("off_nearer_fraction").get<double>();
+  const double farther = points.at("off_farther_fraction").get<double>();
+  EXPECT_LE(nearer + farther + points.at("on_sky_fraction").get<double>(), off + 1e-9)
+      << points.dump();
+  EXPECT_GT(nearer + farther, 0.0) << points.dump();
+  EXPECT_LE(points.at("from_beyond_crop_fraction").get<double>(), nearer) << points.dump();
   EXPECT_FALSE(truth_bottom.contains("points_vs_truth"));
 }
 

@@ -147,7 +147,7 @@ CloudTruthScore TruthDepthRectifier::scoreCloud(const cv::Mat& measured, const c
   CV_Assert(measured.type() == CV_32F && truth.type() == CV_32F && measured.size() == truth.size());
   const auto depthOf = [this](int u, int v, double d) { return rectifiedDepth(q_, u, v, d); };
   CloudTruthScore out;
-  std::size_t off = 0, sky = 0;
+  std::size_t off = 0, sky = 0, nearer = 0, farther = 0, beyond_crop = 0;
   for (int v = 0; v < truth.rows; ++v) {
     const auto* m = measured.ptr<float>(v);
     for (int u = 0; u < truth.cols; ++u) {
@@ -179,13 +179,29 @@ CloudTruthScore TruthDepthRectifier::scoreCloud(const cv::Mat& measured, const c
       }
       if (!any_surface)
         ++sky;
-      if (!near)
-        ++off;
+      if (near)
+        continue;
+      ++off;
+      const float own = truth.at<float>(v, u);
+      if (!(own > 0))
+        continue;
+      const double own_z = depthOf(u, v, own);
+      if (z < own_z) {
+        ++nearer;
+        if (own_z > max_depth_m)
+          ++beyond_crop;
+      } else {
+        ++farther;
+      }
     }
   }
   if (out.points) {
     out.off_surface_fraction = static_cast<double>(off) / static_cast<double>(out.points);
     out.on_sky_fraction = static_cast<double>(sky) / static_cast<double>(out.points);
+    out.off_nearer_fraction = static_cast<double>(nearer) / static_cast<double>(out.points);
+    out.off_farther_fraction = static_cast<double>(farther) / static_cast<double>(out.points);
+    out.from_beyond_crop_fraction =
+        static_cast<double>(beyond_crop) / static_cast<double>(out.points);
   }
   return out;
 }

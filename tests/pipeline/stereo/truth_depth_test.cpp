@@ -141,6 +141,25 @@ TEST(TruthDepth, CloudScoreCountsPointsOffTheSurfaceAndOnSky) {
   // surface on neighbouring rays: a few pixels' worth, inside the tolerance.)
   EXPECT_NEAR(score.on_sky_fraction, 0.25, 0.01);
   EXPECT_NEAR(score.off_surface_fraction, 0.25 + 0.75 / 3.0, 0.01);
+  // The band is nearer than its surface; the sky has no side; nothing lies behind a surface.
+  EXPECT_NEAR(score.off_nearer_fraction, 0.75 / 3.0, 0.01);
+  EXPECT_EQ(score.off_farther_fraction, 0.0);
+  EXPECT_EQ(score.from_beyond_crop_fraction, 0.0);
+  // With the crop between the band's depth and the surface's, the surface is beyond it: only the
+  // band's points are left, those below the sky each a background matched into the crop.
+  const double between = 0.5 * (depthAt(40.0) + depthAt(46.0));
+  const CloudTruthScore pulled_in = truth->scoreCloud(measured, truth_disparity, 0.2, between);
+  EXPECT_EQ(pulled_in.points, static_cast<std::size_t>(size.height) * (size.width / 4));
+  EXPECT_NEAR(pulled_in.off_nearer_fraction, 0.75, 0.01);
+  EXPECT_EQ(pulled_in.from_beyond_crop_fraction, pulled_in.off_nearer_fraction);
+  // A band pushed back 6 px is farther than its surface.
+  cv::Mat pushed_back = measured.clone();
+  pushed_back(
+      cv::Rect(size.width / 2, size.height / 4, size.width / 4, size.height - size.height / 4))
+      .setTo(34.0f);
+  const CloudTruthScore behind = truth->scoreCloud(pushed_back, truth_disparity, 0.2, 5.0);
+  EXPECT_NEAR(behind.off_farther_fraction, 0.75 / 3.0, 0.01);
+  EXPECT_EQ(behind.off_nearer_fraction, 0.0);
   // A point a pixel beside a surface edge is on it: the last sky row next to the surface.
   cv::Mat one_point(size, CV_32F, cv::Scalar(kInvalidDisparity));
   one_point.at<float>(size.height / 4 - 1, size.width / 4) = 40.0f;

@@ -32,6 +32,14 @@ struct CloudTruthScore {
   std::size_t points = 0;           // pixels that become points
   double off_surface_fraction = 0;  // depth more than tolerance from the truth's, or on sky
   double on_sky_fraction = 0;       // the truth has nothing on that ray
+  // The off-surface points by which side of the truth on their own ray they lie (those with no
+  // truth on it are on sky or beside a rim): nearer (a background pulled forward, a near-range
+  // mismatch) or farther (a leaf pushed back). Fractions of `points`.
+  double off_nearer_fraction = 0;
+  double off_farther_fraction = 0;
+  // Of the nearer ones, those whose truth lies beyond max_depth_m: something the depth crop
+  // would have removed (the next row, the far soil) matched into it.
+  double from_beyond_crop_fraction = 0;
 };
 
 // Thread contract: thread-compatible; disparity(), rectifyMask() and score() are const.
