@@ -169,23 +169,20 @@ cv::Mat growConfirmedPieces(const cv::Mat& confident, const cv::Mat& ambiguous, 
   constexpr float kConfirmedWithin = 1.0f;
   const int width = ambiguous.cols;
   const int height = ambiguous.rows;
-  // Pieces are labelled by a flood fill: OpenCV's connectedComponents joins pixels by a binary
+  // Pieces are found by a flood fill: OpenCV's connectedComponents joins pixels by a binary
   // mask only, and filterSpeckles (the same pieces) removes them without saying which is which.
-  std::vector<int> piece(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), -1);
+  std::vector<char> visited(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0);
   std::vector<int> stack;
-  int pieces = 0;
   cv::Mat out = confident.clone();
   std::vector<int> members;
   for (int start = 0; start < width * height; ++start) {
     const int start_x = start % width;
     const int start_y = start / width;
-    if (piece[static_cast<std::size_t>(start)] >= 0 || ambiguous.at<float>(start_y, start_x) < 0) {
+    if (visited[static_cast<std::size_t>(start)] || ambiguous.at<float>(start_y, start_x) < 0)
       continue;
-    }
-    const int label = pieces++;
     members.clear();
     stack.assign(1, start);
-    piece[static_cast<std::size_t>(start)] = label;
+    visited[static_cast<std::size_t>(start)] = 1;
     std::size_t confirmed = 0;
     while (!stack.empty()) {
       const int index = stack.back();
@@ -202,9 +199,9 @@ cv::Mat growConfirmedPieces(const cv::Mat& confident, const cv::Mat& ambiguous, 
           return;
         const int next = ny * width + nx;
         const float nd = ambiguous.at<float>(ny, nx);
-        if (piece[static_cast<std::size_t>(next)] >= 0 || nd < 0 || std::fabs(nd - d) > piece_range)
+        if (visited[static_cast<std::size_t>(next)] || nd < 0 || std::fabs(nd - d) > piece_range)
           return;
-        piece[static_cast<std::size_t>(next)] = label;
+        visited[static_cast<std::size_t>(next)] = 1;
         stack.push_back(next);
       };
       visit(x - 1, y);
