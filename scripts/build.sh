@@ -3,7 +3,8 @@
 # $FIELDRIG_BUILD_TYPE), with the sanitizers of $FIELDRIG_SANITIZE (none when unset; see
 # scripts/test-sanitize.sh). FIELDRIG_UNITY_BUILD=ON compiles each target's sources in batches
 # (CMAKE_UNITY_BUILD): CI's Release and sanitizer builds use it to parse the heavy headers (PCL,
-# OpenCV, Eigen, Boost) once per batch instead of once per file.
+# OpenCV, Eigen, Boost) once per batch instead of once per file. FIELDRIG_BUILD_TARGETS (space
+# separated, e.g. "tests/core/all") builds only those targets and what they need.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${FIELDRIG_BUILD_DIR:-$root/build}
@@ -13,4 +14,5 @@ build_type=${FIELDRIG_BUILD_TYPE:-RelWithDebInfo}
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
   -DFIELDRIG_SANITIZE="${FIELDRIG_SANITIZE:-}" -DCMAKE_UNITY_BUILD="${FIELDRIG_UNITY_BUILD:-OFF}" \
   >/dev/null
-cmake --build "$build" --parallel "$(nproc)" >&2
+read -r -a targets <<<"${FIELDRIG_BUILD_TARGETS:-all}"
+cmake --build "$build" --parallel "$(nproc)" --target "${targets[@]}" >&2

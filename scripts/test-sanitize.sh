@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds fieldrig with AddressSanitizer and UndefinedBehaviorSanitizer (GCC, RelWithDebInfo) into
-# build-asan/ (or $FIELDRIG_BUILD_DIR) and runs every test there. Any sanitizer report fails the
+# build-asan/ (or $FIELDRIG_BUILD_DIR) and runs every test there; given test folders
+# (`scripts/test-sanitize.sh tests/core tests/gps`), it builds and runs only theirs. Any sanitizer report fails the
 # test that caused it: ASan aborts on the first error, UB stops the program
 # (-fno-sanitize-recover), LeakSanitizer fails a program that leaks at exit.
 #
@@ -10,7 +11,13 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${FIELDRIG_BUILD_DIR:-$root/build-asan}
-FIELDRIG_SANITIZE=address,undefined FIELDRIG_BUILD_DIR="$build" "$root/scripts/build.sh"
+folders=("$@")
+targets=all
+if ((${#folders[@]})); then
+  targets=$(printf '%s/all ' "${folders[@]}")
+fi
+FIELDRIG_SANITIZE=address,undefined FIELDRIG_BUILD_DIR="$build" FIELDRIG_BUILD_TARGETS="$targets" \
+  "$root/scripts/build.sh"
 # Stack traces for UB reports; leak detection; and an allocation too large for ASan's allocator
 # returns null from malloc and a non-throwing new, as glibc does (ASan still aborts a throwing
 # new it cannot satisfy), since the frame pool's tests check that such a request is refused with
@@ -18,4 +25,9 @@ FIELDRIG_SANITIZE=address,undefined FIELDRIG_BUILD_DIR="$build" "$root/scripts/b
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}"
 # Instrumented code runs 2-3 times slower: the per-test limit is three times the README build's.
-ctest --test-dir "$build" --output-on-failure --timeout 900 -j "$(nproc)"
+if ((${#folders[@]} == 0)); then
+  folders=(.)
+fi
+for folder in "${folders[@]}"; do
+  ctest --test-dir "$build/$folder" --output-on-failure --timeout 900 -j "$(nproc)"
+done
