@@ -38,12 +38,16 @@ WITHIN_M = 0.03  # issue 11: height and width within 3 cm on every plot
 
 
 def stats(pairs, relative):
-    """pairs: (measured, truth); errors in the unit, or relative (fraction of truth)."""
-    errors = [((m - t) / t if relative else m - t) for m, t in pairs if t]
+    """pairs: (measured, truth); errors in the unit, or relative (fraction of truth). A plot the
+    processing could not measure (measured None) is counted as unmeasured, never left out
+    silently: within_3cm is out of measured and unmeasured plots alike."""
+    errors = [((m - t) / t if relative else m - t) for m, t in pairs if t and m is not None]
+    unmeasured = sum(1 for m, t in pairs if t and m is None)
     if not errors:
         return None
     return {
         "n": len(errors),
+        "unmeasured": unmeasured,
         "mean_abs": sum(abs(e) for e in errors) / len(errors),
         "max_abs": max(abs(e) for e in errors),
         "bias": sum(errors) / len(errors),
@@ -58,14 +62,14 @@ def table(rows, title):
     out = {}
     for key, name, unit in TRAITS:
         relative = unit == ""
-        s = stats([(r["measured"][key], r["truth"][key]) for r in rows
-                   if r["measured"].get(key) is not None], relative)
+        s = stats([(r["measured"].get(key), r["truth"][key]) for r in rows], relative)
         if s is None:
             continue
         out[key] = s
         fmt = (lambda v: f"{100 * v:+.1f} %") if relative else (lambda v: f"{100 * v:+.1f} cm")
-        print(f"| {name} | {s['n']} | {fmt(s['mean_abs'])[1:]} | {fmt(s['max_abs'])[1:]} | "
-              f"{fmt(s['bias'])} |")
+        unmeasured = f" (+{s['unmeasured']} unmeasured)" if s["unmeasured"] else ""
+        print(f"| {name} | {s['n']}{unmeasured} | {fmt(s['mean_abs'])[1:]} | "
+              f"{fmt(s['max_abs'])[1:]} | {fmt(s['bias'])} |")
     return out
 
 
@@ -147,7 +151,9 @@ def measure_field(fieldrig, args, work):
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for r in rows:
         m, t = r["measured"], r["truth"]
-        cells = [f"{m.get(k, float('nan')):.3f} ({t[k]:.3f})" for k, _, _ in TRAITS]
+        # A plot the processing could not measure (its status says why) has no traits: "-".
+        cells = [f"{'-' if m.get(k) is None else format(m[k], '.3f')} ({t[k]:.3f})"
+                 for k, _, _ in TRAITS]
         print(f"| {r['plot']} | {r['stage']} | {t['plant_height_m']:.2f} | "
               f"{'yes' if r['in_view'] else 'no'} | {m['status']} | " + " | ".join(cells) + " |")
     summary = {"plots": len(rows), "all": table(rows, "All plots")}
@@ -168,12 +174,12 @@ def measure_field(fieldrig, args, work):
 
 def length_cells(rows, key):
     """mean abs / worst / bias in cm and the plots within 3 cm, for height_m or width_m."""
-    s = stats([(r["measured"][key], r["truth"][key]) for r in rows
-               if r["measured"].get(key) is not None], False)
+    s = stats([(r["measured"].get(key), r["truth"][key]) for r in rows], False)
     if s is None:
         return "-", None
+    unmeasured = f" ({s['unmeasured']} unmeasured)" if s["unmeasured"] else ""
     return (f"{100 * s['mean_abs']:.1f} / {100 * s['max_abs']:.1f} / {100 * s['bias']:+.1f} | "
-            f"{s['within_3cm']} of {s['n']}"), s
+            f"{s['within_3cm']} of {s['n'] + s['unmeasured']}{unmeasured}"), s
 
 
 def across_fields(per_seed):
