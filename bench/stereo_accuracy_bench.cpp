@@ -36,7 +36,7 @@ Scene aloe() {
   return scene;
 }
 
-// The shipped matcher's row names its settings, read from the options so that it cannot drift.
+// The numbers in the shipped matcher's row are read from its options, so they follow the defaults.
 std::string shippedName(const MatcherOptions& o) {
   return "fieldrig (grey, 3WAY, P1/P2 " + std::to_string(o.p1_per_pixel) + "/" +
          std::to_string(o.p2_per_pixel) + ", uniq " + std::to_string(o.uniqueness_ratio) +

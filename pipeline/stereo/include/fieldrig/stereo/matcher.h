@@ -26,10 +26,10 @@ struct MatcherOptions {
   // SGBM's speckle filter: connected pieces of disparity (neighbours within speckle_range px)
   // smaller than speckle_window pixels are made invalid. On five 24-plot rendered fields (75
   // plots in view, scale 0.5) it is what keeps mismatches out: window 50 put heights 4.6 cm off
-  // on average and 25 cm at worst (100: 2.0 and 11.9), 0 41 cm; 200 cut thin leaves (widths
-  // 14 cm narrow). Range 3 instead of 2 kept more leaf tips (width's mean error against
-  // everything a camera sees 7.8 to 7.1 cm, 16 to 19 plots within 3 cm) and left every worst
-  // case as it was; 4 and 6 raised the worst width from 18 to 21 cm.
+  // on average and 25 cm at worst (100: 2.0 and 11.9), the filter off 41 cm on average; 200 cut
+  // thin leaves (widths 14 cm narrow). Range 3 instead of 2 kept more leaf tips (width's mean error
+  // against everything a camera sees 7.8 to 7.1 cm, 16 to 19 plots within 3 cm) and left every
+  // worst case as it was; 4 and 6 raised the worst width from 18 to 21 cm.
   int speckle_window = 100;  // pixels; 0 disables speckle filtering
   int speckle_range = 3;     // pixels of disparity within one speckle
   // SGBM's own left–right check from the left cost volume (cheap); -1 disables it.
