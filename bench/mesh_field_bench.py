@@ -37,12 +37,17 @@ TRAITS = [("height_m", "height", "m"), ("width_m", "width", "m"), ("vvi", "VVI",
 WITHIN_M = 0.03  # issue 11: height and width within 3 cm on every plot
 
 
+def count_unmeasured(pairs):
+    """Plots with a truth whose measurement is missing (the processing could not measure them)."""
+    return sum(1 for m, t in pairs if t and m is None)
+
+
 def stats(pairs, relative):
     """pairs: (measured, truth); errors in the unit, or relative (fraction of truth). A plot the
     processing could not measure (measured None) is counted as unmeasured, never left out
     silently: within_3cm is out of measured and unmeasured plots alike."""
     errors = [((m - t) / t if relative else m - t) for m, t in pairs if t and m is not None]
-    unmeasured = sum(1 for m, t in pairs if t and m is None)
+    unmeasured = count_unmeasured(pairs)
     if not errors:
         return None
     return {
@@ -62,8 +67,11 @@ def table(rows, title):
     out = {}
     for key, name, unit in TRAITS:
         relative = unit == ""
-        s = stats([(r["measured"].get(key), r["truth"][key]) for r in rows], relative)
+        pairs = [(r["measured"].get(key), r["truth"][key]) for r in rows]
+        s = stats(pairs, relative)
         if s is None:
+            if count_unmeasured(pairs):
+                print(f"| {name} | 0 (+{count_unmeasured(pairs)} unmeasured) | - | - | - |")
             continue
         out[key] = s
         fmt = (lambda v: f"{100 * v:+.1f} %") if relative else (lambda v: f"{100 * v:+.1f} cm")
@@ -174,9 +182,12 @@ def measure_field(fieldrig, args, work):
 
 def length_cells(rows, key):
     """mean abs / worst / bias in cm and the plots within 3 cm, for height_m or width_m."""
-    s = stats([(r["measured"].get(key), r["truth"][key]) for r in rows], False)
+    pairs = [(r["measured"].get(key), r["truth"][key]) for r in rows]
+    s = stats(pairs, False)
     if s is None:
-        return "-", None
+        # No plot measured: the group still says how many plots it had, in both of its columns.
+        unmeasured = count_unmeasured(pairs)
+        return (f"- | 0 of {unmeasured} ({unmeasured} unmeasured)" if unmeasured else "- | -"), None
     unmeasured = f" ({s['unmeasured']} unmeasured)" if s["unmeasured"] else ""
     return (f"{100 * s['mean_abs']:.1f} / {100 * s['max_abs']:.1f} / {100 * s['bias']:+.1f} | "
             f"{s['within_3cm']} of {s['n'] + s['unmeasured']}{unmeasured}"), s
