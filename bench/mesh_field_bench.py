@@ -70,8 +70,9 @@ def table(rows, title):
         pairs = [(r["measured"].get(key), r["truth"][key]) for r in rows]
         s = stats(pairs, relative)
         if s is None:
-            if count_unmeasured(pairs):
-                print(f"| {name} | 0 (+{count_unmeasured(pairs)} unmeasured) | - | - | - |")
+            unmeasured = count_unmeasured(pairs)
+            if unmeasured:
+                print(f"| {name} | 0 (+{unmeasured} unmeasured) | - | - | - |")
             continue
         out[key] = s
         fmt = (lambda v: f"{100 * v:+.1f} %") if relative else (lambda v: f"{100 * v:+.1f} cm")
