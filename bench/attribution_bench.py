@@ -25,7 +25,9 @@ Makes (or reuses) a synthetic field as bench/mesh_field_bench.py does (`fieldrig
 (b) − (a) is what fusion, crop and the traits code cost with perfect depth; (c) − (b) is what
 stereo costs, split into (c0) − (b), the pixels stereo leaves out, and (c) − (c0), the depth it
 gets wrong on the pixels it keeps. For (b), (b') and (c), the near and far edges of each plot's box against the
-truth's box say on which side of the row the width was lost or gained. Per trait: mean absolute
+truth's box say on which side of the row the width was lost or gained, and (c) against (c0) slice
+by slice (the same pixels, each plot sliced over its length from the map) how many slice edges
+stereo's depth errors alone move by more than 3 cm, outward and inward. Per trait: mean absolute
 error, worst, bias (heights and widths in cm, VVI and VAI relative to the truth). Per head,
 stereo against the per-pixel truth on vegetation pixels whose truth depth lies inside the depth
 crop: the fraction matched, the bad-pixel rate (|disparity error| > 2 px at matching
@@ -47,7 +49,8 @@ import subprocess
 import sys
 import tempfile
 
-from mesh_field_bench import add_field_arguments, read_truth, rendered_field, traits_config_args
+from mesh_field_bench import (WITHIN_M, add_field_arguments, read_truth, rendered_field,
+                              traits_config_args)
 
 TRAITS = [("height_m", "height", "m"), ("width_m", "width", "m"), ("vvi", "VVI", ""),
           ("vai", "VAI", "")]
@@ -85,6 +88,86 @@ def process(fieldrig, field, out, extra, args):
     return read_results(os.path.join(out, "plots.jsonl"))
 
 
+SLICE_BOUNDS_AGREE_M = 0.005  # slices of (c) and (c0) compared when both bounds agree this well
+
+
+def plot_slices(fieldrig, cloud, traits_config):
+    """The slices and width `fieldrig traits --json` gives one plot cloud written by --clouds."""
+    result = json.loads(subprocess.run(
+        [fieldrig, "traits", "--cloud", cloud, "--json", "--config", traits_config], check=True,
+        capture_output=True, text=True).stdout)
+    return result.get("slices", []), result.get("width_m")
+
+
+def slice_edge_table(fieldrig, work, plots, truth, from_coverage, coverage_dir, from_stereo,
+                     stereo_dir, args):
+    """(c) against (c0) slice by slice. Both clouds hold exactly the pixels stereo matched, (c0)
+    with the truth's depth, so a slice edge more than 3 cm apart was moved by a wrong stereo depth
+    and by nothing else: the stereo-caused share of slice edges, by side. Each run slices its own
+    plants' extent along the row, which stereo's mismatches stretch (bounds 2-20 cm apart on
+    rendered plots), so both clouds are sliced over the plot's own length from the map
+    (crop_to_row_length, the trait definitions otherwise those of the processing) and only slices
+    whose bounds agree are compared."""
+    traits_config = os.path.join(work, "slice-comparison-traits.yaml")
+    with open(traits_config, "w") as out:
+        if args.traits_config:
+            with open(args.traits_config) as f:
+                text = f.read()
+            if "crop_to_row_length" in text or text.lstrip().startswith("{"):
+                sys.exit(f"{args.traits_config}: the slice comparison adds crop_to_row_length to "
+                         f"a YAML traits config that does not set it")
+            out.write(text.rstrip("\n") + "\n")
+        out.write("crop_to_row_length: true\n")
+    print(f"\nSlice edges moved by stereo's depth alone: (c) stereo against (c0) truth depth on "
+          f"the same pixels, {len(plots)} plots, each sliced over its length from the map "
+          f"(crop_to_row_length; widths here by that definition), comparing the slices whose "
+          f"bounds agree within {1000 * SLICE_BOUNDS_AGREE_M:.0f} mm. A far edge 'out' lies "
+          f"> 3 cm farther from the cameras than (c0)'s, 'in' > 3 cm nearer; a near edge 'out' "
+          f"> 3 cm nearer, 'in' > 3 cm farther (out widens the slice, in narrows it)"
+          + ("; --process-args names a --config, whose traits options this does not read"
+             if "--config" in args.process_args else ""))
+    print("| plot | stage | width m: (c0) | (c) | slices compared | far out | far in | "
+          "near out | near in |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    keys = ("far_out", "far_in", "near_out", "near_in")
+    totals = dict.fromkeys(("slices", "compared") + keys, 0)
+    per_plot = {}
+    for p in plots:
+        clouds = [os.path.join(directory, f"{p}_set{results.get(p, {}).get('set')}.ply")
+                  for directory, results in ((stereo_dir, from_stereo),
+                                             (coverage_dir, from_coverage))]
+        if not all(os.path.exists(c) for c in clouds):
+            print(f"| {p} | {truth[p].get('stage', '?')} | — | — | no cloud (not measured) "
+                  f"| | | | |")
+            continue
+        (stereo_slices, stereo_width), (coverage_slices, coverage_width) = (
+            plot_slices(fieldrig, c, traits_config) for c in clouds)
+        counts = dict.fromkeys(totals, 0)
+        counts["slices"] = len(stereo_slices)
+        for stereo, coverage in zip(stereo_slices, coverage_slices):
+            aligned = (abs(stereo["y_begin"] - coverage["y_begin"]) <= SLICE_BOUNDS_AGREE_M and
+                       abs(stereo["y_end"] - coverage["y_end"]) <= SLICE_BOUNDS_AGREE_M)
+            if not aligned or not stereo.get("points") or not coverage.get("points"):
+                continue
+            counts["compared"] += 1
+            counts["far_out"] += stereo["z_max"] > coverage["z_max"] + WITHIN_M
+            counts["far_in"] += stereo["z_max"] < coverage["z_max"] - WITHIN_M
+            counts["near_out"] += stereo["z_min"] < coverage["z_min"] - WITHIN_M
+            counts["near_in"] += stereo["z_min"] > coverage["z_min"] + WITHIN_M
+        for key in totals:
+            totals[key] += counts[key]
+        per_plot[p] = dict(counts, width_c0_m=coverage_width, width_c_m=stereo_width)
+        widths = " | ".join("—" if w is None else f"{w:.3f}"
+                            for w in (coverage_width, stereo_width))
+        print(f"| {p} | {truth[p].get('stage', '?')} | {widths} | "
+              f"{counts['compared']} of {counts['slices']} | "
+              + " | ".join(str(counts[k]) for k in keys) + " |")
+    n = totals["compared"]
+    print(f"| all | | | | {n} of {totals['slices']} | " + " | ".join(
+        f"{totals[k]} ({100 * totals[k] / n:.0f} %)" if n else "0" for k in keys) + " |")
+    return {"totals": totals, "plots": per_plot}
+
+
 def main():
     parser = argparse.ArgumentParser()
     add_field_arguments(parser, plots=8)
@@ -110,10 +193,12 @@ def main():
         from_truth_edges = process(fieldrig, field,
                                    os.path.join(work, "results-truth-depth-edge-filter"),
                                    ["--depth-source", "truth", "--config", edges], args)
-    from_coverage = process(fieldrig, field, os.path.join(work, "results-truth-where-matched"),
-                            ["--depth-source", "truth-where-matched"], args)
-    from_stereo = process(fieldrig, field, os.path.join(work, "results-stereo"),
-                          ["--score-stereo"], args)
+    # (c0) and (c) keep their plot clouds (--clouds) for the slice-by-slice comparison below.
+    coverage_dir = os.path.join(work, "results-truth-where-matched")
+    stereo_dir = os.path.join(work, "results-stereo")
+    from_coverage = process(fieldrig, field, coverage_dir,
+                            ["--depth-source", "truth-where-matched", "--clouds"], args)
+    from_stereo = process(fieldrig, field, stereo_dir, ["--score-stereo", "--clouds"], args)
     for name, results in (("truth depth", from_truth), ("truth where matched", from_coverage),
                           ("stereo", from_stereo)):
         for plot in results:
@@ -202,6 +287,9 @@ def main():
                          f"{fmt(s['bias'], False, True)}")
         summary["edges"][label.split(" ")[0]] = row_summary
         print(f"| {label} | " + " | ".join(cells) + " |")
+
+    summary["slice_edges"] = slice_edge_table(fieldrig, work, plots, truth, from_coverage,
+                                              coverage_dir, from_stereo, stereo_dir, args)
 
     print("\nPer head, stereo against the per-pixel truth (vegetation pixels inside the depth crop; "
           "bad = |disparity error| > 2 px at matching resolution, of the matched pixels); "
