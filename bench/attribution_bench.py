@@ -92,10 +92,16 @@ SLICE_BOUNDS_AGREE_M = 0.005  # slices of (c) and (c0) compared when both bounds
 
 
 def plot_slices(fieldrig, cloud, traits_config):
-    """The slices and width `fieldrig traits --json` gives one plot cloud written by --clouds."""
-    result = json.loads(subprocess.run(
-        [fieldrig, "traits", "--cloud", cloud, "--json", "--config", traits_config], check=True,
-        capture_output=True, text=True).stdout)
+    """The slices and width `fieldrig traits --json` gives one plot cloud written by --clouds;
+    no slices when it measures nothing there (its status, or its error, says why)."""
+    run = subprocess.run([fieldrig, "traits", "--cloud", cloud, "--json", "--config",
+                          traits_config], capture_output=True, text=True)
+    try:
+        result = json.loads(run.stdout)
+    except json.JSONDecodeError:
+        print(f"{cloud}: fieldrig traits exited {run.returncode}: {run.stderr.strip()}",
+              file=sys.stderr)
+        return [], None
     return result.get("slices", []), result.get("width_m")
 
 
