@@ -81,6 +81,12 @@ def read_results(path):
 
 
 def process(fieldrig, field, out, extra, args):
+    # --force replaces the results but not the plot clouds of an earlier run into the same folder,
+    # which the slice comparison would otherwise take for this run's where a set wrote none.
+    if os.path.isdir(out):
+        for name in os.listdir(out):
+            if name.endswith(".ply"):
+                os.remove(os.path.join(out, name))
     subprocess.run([fieldrig, "process", os.path.join(field, "source-session"), "--map",
                     os.path.join(field, "map.csv"), "--out", out, "--force"] + extra +
                    traits_config_args(args) + shlex.split(args.process_args), check=True,
@@ -119,9 +125,14 @@ def slice_edge_table(fieldrig, work, plots, truth, from_coverage, coverage_dir, 
         if args.traits_config:
             with open(args.traits_config) as f:
                 text = f.read()
-            if "crop_to_row_length" in text or text.lstrip().startswith("{"):
-                sys.exit(f"{args.traits_config}: the slice comparison adds crop_to_row_length to "
-                         f"a YAML traits config that does not set it")
+            # Appended as a YAML line: a JSON file, or one that sets the key already, would
+            # come out invalid or with the key twice.
+            if text.lstrip().startswith("{"):
+                sys.exit(f"{args.traits_config}: the slice comparison needs a YAML traits config "
+                         f"(it adds crop_to_row_length to it), not JSON")
+            if "crop_to_row_length" in text:
+                sys.exit(f"{args.traits_config}: crop_to_row_length is set here; the slice "
+                         f"comparison sets it itself (true), so leave it out")
             out.write(text.rstrip("\n") + "\n")
         out.write("crop_to_row_length: true\n")
     print(f"\nSlice edges moved by stereo's depth alone: (c) stereo against (c0) truth depth on "
