@@ -62,6 +62,7 @@ void readTraits(const Value& section, traits::TraitsOptions& o) {
           {"intra_row_spacing_m", positive(o.intra_row_spacing_m)},
           {"slices", integer(o.slices, 0)},
           {"slice_width_quantile", numberIn(o.slice_width_quantile, 0, 0.25)},
+          {"width_band_m", numberIn(o.width_band_m, 0, 100)},
           {"min_row_extent_m", nonNegative(o.min_row_extent_m)},
           {"min_plant_points",
            [&](const Value& v) {

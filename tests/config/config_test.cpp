@@ -140,6 +140,7 @@ void expectSame(const traits::TraitsOptions& actual, const traits::TraitsOptions
   EXPECT_FIELD(intra_row_spacing_m);
   EXPECT_FIELD(slices);
   EXPECT_FIELD(slice_width_quantile);
+  EXPECT_FIELD(width_band_m);
   EXPECT_FIELD(min_row_extent_m);
   EXPECT_FIELD(min_plant_points);
   EXPECT_FIELD(alpha);
@@ -857,6 +858,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
                                   "intra_row_spacing_m: 0.1\n"
                                   "slices: 30\n"
                                   "slice_width_quantile: 0.03\n"
+                                  "width_band_m: 0.6\n"
                                   "min_row_extent_m: 0.1\n"
                                   "min_plant_points: 80\n"
                                   "alpha: 0.35\n"
@@ -897,6 +899,7 @@ TEST(TraitsOptionsFile, YamlFileLoadsEveryField) {
   expected.intra_row_spacing_m = 0.1;
   expected.slices = 30;
   expected.slice_width_quantile = 0.03;
+  expected.width_band_m = 0.6;
   expected.min_row_extent_m = 0.1;
   expected.min_plant_points = 80;
   expected.alpha = 0.35;

@@ -107,6 +107,7 @@ nlohmann::ordered_json traitsToJson(const TraitsResult& r, bool with_slices) {
                    {q.base_edge_centre.x(), q.base_edge_centre.y(), q.base_edge_centre.z()}},
                   {"slices", q.slices},
                   {"occupied_slices", q.occupied_slices},
+                  {"width_slices", q.width_slices},
                   {"valid_slices", q.valid_slices},
                   {"slice_top_spread_m", q.slice_top_spread_m},
                   {"slice_near_spread_m", q.slice_near_spread_m},

@@ -190,6 +190,7 @@ std::optional<OptionsProblem> TraitsOptions::validate() const {
       // sliceCount's own ceiling for a count derived from the row.
       outOfRange("slices", slices, 0, 1000),
       outOfRange("slice_width_quantile", slice_width_quantile, 0, 0.25),
+      outOfRange("width_band_m", width_band_m, 0, 100),
       outOfRange("min_row_extent_m", min_row_extent_m, 0, 100),
       outOfRange("min_plant_points", static_cast<double>(min_plant_points), 0, 1e9),
       outOfRange("alpha", alpha, 0, 1, true),
@@ -367,7 +368,7 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& all_plant
     result.slices[i].z_min = at(k);
     result.slices[i].z_max = at(depths.size() - 1 - k);
   }
-  std::vector<std::pair<double, double>> x_max, z_min, z_max;
+  std::vector<std::pair<double, double>> x_max, z_min, z_max, band_z_min, band_z_max;
   for (SliceStats& s : result.slices) {
     if (s.points == 0) {
       s.x_max = s.z_min = s.z_max = 0.0;  // no NaN or infinity leaves this function
@@ -378,7 +379,17 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& all_plant
     x_max.emplace_back(s.x_max, w);
     z_min.emplace_back(s.z_min, w);
     z_max.emplace_back(s.z_max, w);
+    if (std::abs(0.5 * (s.y_begin + s.y_end)) <= 0.5 * options.width_band_m) {
+      band_z_min.emplace_back(s.z_min, w);
+      band_z_max.emplace_back(s.z_max, w);
+    }
   }
+  // Without a slice in the band (plants beside the location only) every slice gives the width.
+  if (options.width_band_m > 0.0 && !band_z_min.empty()) {
+    z_min = std::move(band_z_min);
+    z_max = std::move(band_z_max);
+  }
+  result.quality.width_slices = static_cast<int>(z_min.size());
   if (result.quality.occupied_slices < 2)
     return failed(std::move(result), TraitsStatus::kSingleSlice,
                   "points in " + std::to_string(result.quality.occupied_slices) +

@@ -87,6 +87,61 @@ TEST(SliceExtent, AWidthQuantileIgnoresTheStrayVoxelsAndLeavesTheTop) {
   EXPECT_NEAR(result.height_m, 1.30, 1e-3);  // the top is still the slices' highest point
 }
 
+// A 2 m long row of plant points 0.6-1.2 m from the camera, 1 m tall, whose near side a side-view
+// camera sees only around the plot's location: beyond |y| = 0.2 m the nearest point seen moves
+// back 0.8 m for each metre along the row, as at the edge of a camera's view (none seen beyond
+// |y| = 0.94 m).
+Points rowSeenNearOnlyInTheMiddle() {
+  Points points;
+  const float step = 0.02F;
+  for (int j = 0; j <= 100; ++j) {
+    const float y = -1.0F + j * step;
+    const float near_seen = 0.6F + 0.8F * std::max(0.0F, std::abs(y) - 0.2F);
+    for (int i = 0; i <= 50; ++i)
+      for (int k = 0; k <= 30; ++k) {
+        const float z = 0.6F + k * step;
+        if (z >= near_seen - 1e-4F)
+          points.emplace_back(i * step, y, z);
+      }
+  }
+  return points;
+}
+
+TEST(SliceExtent, AWidthBandTakesTheEdgesWhereTheNearSideIsInView) {
+  const TraitsResult all = traitsFromPlantPoints(rowSeenNearOnlyInTheMiddle(), 0.0, {});
+  ASSERT_TRUE(all.heightWidthValid()) << all.message;
+  // Every slice: the slices toward the ends, where the view cut the near side, carry the median.
+  EXPECT_LT(all.width_m, 0.55);
+  EXPECT_EQ(all.quality.width_slices, all.quality.occupied_slices);
+
+  TraitsOptions options;
+  options.width_band_m = 0.4;
+  const TraitsResult band = traitsFromPlantPoints(rowSeenNearOnlyInTheMiddle(), 0.0, options);
+  ASSERT_TRUE(band.heightWidthValid()) << band.message;
+  EXPECT_NEAR(band.width_m, 0.6, 0.021);
+  EXPECT_NEAR(band.height_m, all.height_m, 1e-9);  // the height still comes from every slice
+  // 20 slices of 9.4 cm: the four whose middle lies within 0.2 m of the location.
+  EXPECT_EQ(band.quality.width_slices, 4);
+  EXPECT_EQ(traitsToJson(band).at("quality").at("width_slices").get<int>(), 4);
+}
+
+// Plants beside the location only (a plot at the end of the view): no slice in the band, so every
+// slice gives the width rather than none.
+TEST(SliceExtent, AWidthBandWithoutSlicesInItUsesEverySlice) {
+  Points points;
+  for (const Eigen::Vector3f& p : rowSeenNearOnlyInTheMiddle()) {
+    if (p.y() > 0.5F)
+      points.push_back(p);
+  }
+  TraitsOptions options;
+  options.width_band_m = 0.4;
+  const TraitsResult band = traitsFromPlantPoints(points, 0.0, options);
+  const TraitsResult all = traitsFromPlantPoints(points, 0.0, {});
+  ASSERT_TRUE(band.heightWidthValid()) << band.message;
+  EXPECT_DOUBLE_EQ(band.width_m, all.width_m);
+  EXPECT_EQ(band.quality.width_slices, band.quality.occupied_slices);
+}
+
 TEST(WeightedQuantile, IsTheFirstSortedValueReachingThatShareOfTheWeight) {
   // Sorted: 1 (0.2), 2 (0.2), 3 (0.2), 10 (0.4): cumulative 0.2, 0.4, 0.6, 1.0.
   const std::vector<std::pair<double, double>> values{

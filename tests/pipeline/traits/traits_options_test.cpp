@@ -48,6 +48,7 @@ TEST(TraitsOptionsValidate, NamesTheKeyAndTheRange) {
       {"slice_width_quantile", [](TraitsOptions& o) { o.slice_width_quantile = 0.3; }, "[0, 0.25]"},
       {"slice_width_quantile", [](TraitsOptions& o) { o.slice_width_quantile = -0.01; },
        "[0, 0.25]"},
+      {"width_band_m", [](TraitsOptions& o) { o.width_band_m = -0.1; }, "[0, 100]"},
       {"gpt_max_neighbors", [](TraitsOptions& o) { o.gpt_max_neighbors = -5; }, "[1, 10000]"},
       {"camera_to_plot", [&](TraitsOptions& o) { o.camera_to_plot(1, 2) = kNan; }, "[-1000, 1000]"},
       {"crop_z_min_m", [](TraitsOptions& o) { o.crop_z_min_m = 2.0; }, "crop_z_max_m (1.7)"},

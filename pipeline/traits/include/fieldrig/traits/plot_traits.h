@@ -83,7 +83,10 @@ struct TraitsOptions {
   // Off: on the 24-plot rendered field (bench/mesh_field_bench.py, seed 11, the truth cropped
   // alike) width against what any camera sees stayed as it was (6.6 → 6.8 cm mean abs) and VVI got
   // worse (5.7 → 7.9 %); against what both cameras of a head see, width improved (5.7 → 4.8 cm on
-  // the plots in view). An earlier "worse" (width 8.3 cm) was against an uncropped truth.
+  // the plots in view). An earlier "worse" (width 8.3 cm) was against an uncropped truth. On five
+  // fields (75 in-view plots) it lines the slices up with the truth's: with the truth's own depth
+  // the height came within 3 cm on 74 plots (off: 70; worst 7.7 to 3.2 cm) and the width on 45
+  // (off: 40), but through stereo height and width stayed as they were (60 and 20 plots).
   bool crop_to_row_length = false;
   double intra_row_spacing_m = 0.15;
   int slices = 0;
@@ -97,6 +100,18 @@ struct TraitsOptions {
   // deeper there. The top stays the slice's highest point: a quantile there made height worse
   // (2.2 to 4.0 cm).
   double slice_width_quantile = 0.0;
+  // The width's near and far edges come from the slices whose middle lies within
+  // ±width_band_m / 2 of the plot's location (y = 0); 0: every slice (the paper). Side-view
+  // cameras see the near side of the canopy only where it is inside their view (the rig's: |y|
+  // below 0.6 times the depth): toward the row's ends a slice's nearest point is where the view
+  // ends, not where the leaves end, and the slices' near edges spread over up to 30 cm, so the
+  // median moves with the slices' weights. Off: on five rendered fields (75 in-view plots, both
+  // truth and processing with crop_to_row_length and the same band) 0.6 brought the width with
+  // the truth's own depth within 3 cm on 60 plots against what any camera sees (0: 45) and made
+  // it nearer the plants' whole canopy (mean error 9.7 to 3.9 cm), but through stereo it did not
+  // help (7.0 to 7.7 cm mean, 20 plots within 3 cm either way; worst 18 to 21 cm): fewer slices
+  // give less room for stereo's edge errors. 0.9 sat in between.
+  double width_band_m = 0.0;
   double min_row_extent_m = 0.05;  // shorter plants-only extent along y is "one slice only"
   std::size_t min_plant_points = 50;
   double alpha = 0.3;               // slice validity: hull volume / slice box volume
@@ -177,6 +192,7 @@ struct TraitsQuality {
   Eigen::Vector3d base_edge_centre = Eigen::Vector3d::Zero();
   int slices = 0;
   int occupied_slices = 0;
+  int width_slices = 0;  // occupied slices that gave the width's edges (width_band_m)
   int valid_slices = 0;
   // How much the occupied slices disagree on their top, near edge and far edge: the weighted
   // interquartile range of each, m. Height and width are weighted medians over the slices, so a
