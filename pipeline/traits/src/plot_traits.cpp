@@ -379,13 +379,14 @@ TraitsResult traitsFromPlantPoints(const std::vector<Eigen::Vector3f>& all_plant
     x_max.emplace_back(s.x_max, w);
     z_min.emplace_back(s.z_min, w);
     z_max.emplace_back(s.z_max, w);
-    if (std::abs(0.5 * (s.y_begin + s.y_end)) <= 0.5 * options.width_band_m) {
+    if (options.width_band_m > 0.0 &&
+        std::abs(0.5 * (s.y_begin + s.y_end)) <= 0.5 * options.width_band_m) {
       band_z_min.emplace_back(s.z_min, w);
       band_z_max.emplace_back(s.z_max, w);
     }
   }
   // Without a slice in the band (plants beside the location only) every slice gives the width.
-  if (options.width_band_m > 0.0 && !band_z_min.empty()) {
+  if (!band_z_min.empty()) {
     z_min = std::move(band_z_min);
     z_max = std::move(band_z_max);
   }

@@ -192,7 +192,9 @@ struct TraitsQuality {
   Eigen::Vector3d base_edge_centre = Eigen::Vector3d::Zero();
   int slices = 0;
   int occupied_slices = 0;
-  int width_slices = 0;  // occupied slices that gave the width's edges (width_band_m)
+  // Occupied slices that gave the width's edges (fewer with width_band_m; the near and far
+  // spreads below are over these).
+  int width_slices = 0;
   int valid_slices = 0;
   // How much the occupied slices disagree on their top, near edge and far edge: the weighted
   // interquartile range of each, m. Height and width are weighted medians over the slices, so a
