@@ -30,6 +30,7 @@ import copy
 import json
 import os
 import shlex
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -45,10 +46,11 @@ def count_unmeasured(pairs):
     return sum(1 for m, t in pairs if t and m is None)
 
 
-def stats(pairs, relative):
+def stats(pairs, relative, within=None):
     """pairs: (measured, truth); errors in the unit, or relative (fraction of truth). A plot the
     processing could not measure (measured None) is counted as unmeasured, never left out
-    silently: within_3cm is out of measured and unmeasured plots alike."""
+    silently: within_3cm is out of measured and unmeasured plots alike. With `within`, also how
+    many errors are within that bound (in the errors' unit)."""
     errors = [((m - t) / t if relative else m - t) for m, t in pairs if t and m is not None]
     unmeasured = count_unmeasured(pairs)
     if not errors:
@@ -60,6 +62,7 @@ def stats(pairs, relative):
         "max_abs": max(abs(e) for e in errors),
         "bias": sum(errors) / len(errors),
         "within_3cm": None if relative else sum(abs(e) <= WITHIN_M for e in errors),
+        **({} if within is None else {"within": sum(abs(e) <= within for e in errors)}),
     }
 
 
@@ -243,14 +246,6 @@ def across_fields(per_seed):
     return out
 
 
-def median(values):
-    values = sorted(values)
-    if not values:
-        return None
-    middle = len(values) // 2
-    return values[middle] if len(values) % 2 else 0.5 * (values[middle - 1] + values[middle])
-
-
 def indices_by_stage(pooled):
     """VVI and VAI of the in-view plots of every field, per stage, against both truths, with how
     many are within issue 11's bounds; and VAI's two factors against the seen truth: VAI is the
@@ -272,21 +267,19 @@ def indices_by_stage(pooled):
             for view, truth_of in (("seen", lambda r: r["truth"]),
                                    ("stereo_view", lambda r: r["truth"].get("stereo_view", {}))):
                 pairs = [(r["measured"].get(key), truth_of(r).get(key)) for r in rows]
-                s = stats(pairs, True)
+                s = stats(pairs, True, within=WITHIN_RELATIVE[key])
                 if s is None:
                     cells.append("- | -")
                     continue
-                errors = [(m - t) / t for m, t in pairs if t and m is not None]
-                s["within"] = sum(abs(e) <= WITHIN_RELATIVE[key] for e in errors)
                 out[stage][f"{key}_vs_{view}"] = s
                 cells.append(f"{100 * s['mean_abs']:.1f} / {100 * s['max_abs']:.1f} / "
                              f"{100 * s['bias']:+.1f} | {s['within']} of {s['n'] + s['unmeasured']}")
         factors = []
         for measured_key, truth_key in (("total_area_m2", "visible_area_in_box_m2"),
                                         ("ega_m2", "ega_m2")):
-            ratio = median([r["measured"][measured_key] / r["truth"][truth_key] for r in rows
-                            if r["measured"].get(measured_key) is not None and
-                            r["truth"].get(truth_key)])
+            ratios = [r["measured"][measured_key] / r["truth"][truth_key] for r in rows
+                      if r["measured"].get(measured_key) is not None and r["truth"].get(truth_key)]
+            ratio = statistics.median(ratios) if ratios else None
             out[stage][f"{measured_key}_ratio"] = ratio
             factors.append("-" if ratio is None else f"{ratio:.2f}")
         print(f"| {stage} | " + " | ".join(cells + factors) + " |")
