@@ -14,8 +14,13 @@
 namespace fieldrig::sim {
 namespace {
 
-constexpr int kTile = 4;  // pixels per side of a tile: one 16-ray packet per sample position
-constexpr int kPacket = kTile * kTile;
+// A tile of 4 × 2 pixels: one 8-ray packet per sample position. Eight rays are the width of
+// Embree's AVX2 kernels on this machine; with 16-ray packets (4 × 4 tiles) the mature plot's
+// FrameSet took 0.2 s (6 %) longer on average over five alternated runs of
+// bench/mesh_render_bench, with the same frames bit for bit.
+constexpr int kTileW = 4;
+constexpr int kTileH = 2;
+constexpr int kPacket = kTileW * kTileH;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 // Embree asks for flush-to-zero and denormals-are-zero on the threads that trace; the previous
@@ -132,7 +137,7 @@ Eigen::Vector3f shade(const ShadePoint& s, const Lighting& light) {
   return {m.albedo.z() * k, m.albedo.y() * k, m.albedo.x() * k};
 }
 
-void setRay(RTCRay16& ray, int lane, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
+void setRay(RTCRay8& ray, int lane, const Eigen::Vector3f& o, const Eigen::Vector3f& d,
             float tfar) {
   ray.org_x[lane] = o.x();
   ray.org_y[lane] = o.y();
@@ -171,7 +176,7 @@ struct Hit {
   Eigen::Vector3f dir = Eigen::Vector3f::UnitZ();
 };
 
-Hit hitOf(const RTCRayHit16& packet, int lane) {
+Hit hitOf(const RTCRayHit8& packet, int lane) {
   Hit h;
   h.geom = packet.hit.geomID[lane];
   h.t = packet.ray.tfar[lane];
@@ -194,7 +199,7 @@ struct RenderScratch {
   std::vector<EdgeKey> keys;
 };
 
-void traceRays(RTCScene scene, RTCIntersectContext& context, RTCRayHit16& packet,
+void traceRays(RTCScene scene, RTCIntersectContext& context, RTCRayHit8& packet,
                std::array<int, kPacket>& valid, const Eigen::Vector3f& origin,
                const Eigen::Vector3f* directions, int count) {
   for (int lane = 0; lane < kPacket; ++lane) {
@@ -204,7 +209,7 @@ void traceRays(RTCScene scene, RTCIntersectContext& context, RTCRayHit16& packet
     packet.hit.geomID[lane] = RTC_INVALID_GEOMETRY_ID;
     packet.hit.instID[0][lane] = RTC_INVALID_GEOMETRY_ID;
   }
-  rtcIntersect16(valid.data(), scene, &context, &packet);
+  rtcIntersect8(valid.data(), scene, &context, &packet);
 }
 
 }  // namespace
@@ -330,8 +335,8 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
     return Eigen::Vector3f(directionAt(col, row) + dx * du + dy * dv);
   };
 
-  const int tiles_x = (width + kTile - 1) / kTile;
-  const int tiles_y = (height + kTile - 1) / kTile;
+  const int tiles_x = (width + kTileW - 1) / kTileW;
+  const int tiles_y = (height + kTileH - 1) / kTileH;
   // Pass 1: the ray through every pixel centre (the truth, and the colour where the pixel shows
   // one surface).
   std::vector<Hit>& centres = scratch.centres;
@@ -344,16 +349,16 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    alignas(64) RTCRayHit16 packet;
-    alignas(64) std::array<int, kPacket> valid{};  // rtcIntersect16 reads it aligned
+    alignas(64) RTCRayHit8 packet;
+    alignas(64) std::array<int, kPacket> valid{};  // Embree reads it aligned
     std::array<Eigen::Vector3f, kPacket> dirs;
     std::array<int, kPacket> index{};
     for (int ty = range.start; ty < range.end; ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
         int count = 0;
         for (int lane = 0; lane < kPacket; ++lane) {
-          const int col = tx * kTile + lane % kTile;
-          const int row = ty * kTile + lane / kTile;
+          const int col = tx * kTileW + lane % kTileW;
+          const int row = ty * kTileH + lane / kTileW;
           if (col >= width || row >= height)
             continue;
           index[static_cast<std::size_t>(count)] = row * width + col;
@@ -380,9 +385,9 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
     RTCIntersectContext shadow_context;
     rtcInitIntersectContext(&shadow_context);
     shadow_context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;  // parallel rays from one tile
-    alignas(64) RTCRayHit16 packet;
-    alignas(64) RTCRay16 shadow;
-    alignas(64) std::array<int, kPacket> valid{};  // rtcIntersect16 reads it aligned
+    alignas(64) RTCRayHit8 packet;
+    alignas(64) RTCRay8 shadow;
+    alignas(64) std::array<int, kPacket> valid{};  // Embree reads it aligned
     std::array<Eigen::Vector3f, kPacket> dirs;
     std::vector<Hit> sample_hits(4 * kPacket);
     std::vector<ShadePoint> points;
@@ -436,11 +441,11 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
     for (int ty = range.start; ty < range.end; ++ty) {
       for (int tx = 0; tx < tiles_x; ++tx) {
         auto pixelOf = [&](int lane, int& col, int& row) {
-          col = tx * kTile + lane % kTile;
-          row = ty * kTile + lane / kTile;
+          col = tx * kTileW + lane % kTileW;
+          row = ty * kTileH + lane / kTileW;
           return col < width && row < height;
         };
-        // The edges' four samples, four pixels to a packet.
+        // The edges' four samples, two pixels to a packet.
         int edges = 0;
         std::array<int, kPacket> edge_lanes{};
         for (int lane = 0; lane < kPacket; ++lane) {
@@ -451,8 +456,8 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
           if (edge[static_cast<std::size_t>(lane)])
             edge_lanes[static_cast<std::size_t>(edges++)] = lane;
         }
-        for (int first = 0; first < edges; first += 4) {
-          const int pixels = std::min(4, edges - first);
+        for (int first = 0; first < edges; first += kPacket / 4) {
+          const int pixels = std::min(kPacket / 4, edges - first);
           for (int p = 0; p < pixels; ++p) {
             int col = 0;
             int row = 0;
@@ -515,7 +520,7 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
               addPoint(h, lane, 1.0F);
           }
         }
-        // Shadow rays towards the sun, 16 at a time, from just off the lit side.
+        // Shadow rays towards the sun, a packet at a time, from just off the lit side.
         for (std::size_t first = 0; first < points.size(); first += kPacket) {
           bool any = false;
           for (int lane = 0; lane < kPacket; ++lane) {
@@ -532,7 +537,7 @@ MeshFrame renderMeshFrame(const MeshRenderScene& render_scene, const MeshCamera&
           }
           if (!any)
             continue;
-          rtcOccluded16(valid.data(), scene, &shadow_context, &shadow);
+          rtcOccluded8(valid.data(), scene, &shadow_context, &shadow);
           for (int lane = 0; lane < kPacket; ++lane) {
             const std::size_t i = first + static_cast<std::size_t>(lane);
             if (i < points.size() && points[i].wants_shadow_ray)
@@ -603,8 +608,8 @@ std::vector<std::uint8_t> camerasSeeing(const MeshRenderScene& render_scene,
   const int blocks = static_cast<int>((points.size() + kPacket - 1) / kPacket);
   cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& range) {
     const FlushDenormals flush;
-    alignas(64) RTCRay16 rays;
-    alignas(64) std::array<int, kPacket> valid{};  // rtcIntersect16 reads it aligned
+    alignas(64) RTCRay8 rays;
+    alignas(64) std::array<int, kPacket> valid{};  // Embree reads it aligned
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     for (int block = range.start; block < range.end; ++block) {
@@ -640,7 +645,7 @@ std::vector<std::uint8_t> camerasSeeing(const MeshRenderScene& render_scene,
         }
         if (!any)
           continue;
-        rtcOccluded16(valid.data(), scene, &context, &rays);
+        rtcOccluded8(valid.data(), scene, &context, &rays);
         for (int lane = 0; lane < kPacket; ++lane) {
           const std::size_t i = first + static_cast<std::size_t>(lane);
           if (valid[static_cast<std::size_t>(lane)] != 0 && rays.tfar[lane] >= 0.0F)
