@@ -21,6 +21,7 @@ namespace {
 constexpr int kTileW = 4;
 constexpr int kTileH = 2;
 constexpr int kPacket = kTileW * kTileH;
+static_assert(kPacket % 4 == 0, "an edge pixel's four samples share one packet");
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 // Embree asks for flush-to-zero and denormals-are-zero on the threads that trace; the previous
