@@ -87,6 +87,19 @@ std::string replaceFileAtomically(const std::filesystem::path& path, std::string
   return {};
 }
 
+std::string writeWholeFile(const std::filesystem::path& path, std::string_view data) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    return path.string() + ": cannot create: " + std::strerror(errno);
+  int error = writeFully(fd, data.data(), data.size());
+  // close() reports what a network or full file system deferred.
+  if (::close(fd) != 0 && error == 0)
+    error = errno;
+  if (error != 0)
+    return path.string() + ": cannot write: " + std::strerror(error);
+  return {};
+}
+
 std::string appendDurably(const std::filesystem::path& path, std::string_view text) {
   const bool existed = std::filesystem::exists(path);
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);

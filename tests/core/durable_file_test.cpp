@@ -10,8 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -104,6 +106,20 @@ TEST(DurableFileTest, ReplaceAndAppendWriteWhatTheySayAndNameThePathInErrors) {
   std::string error;
   EXPECT_FALSE(readWholeFile(missing, error).has_value());
   EXPECT_EQ(error.rfind(missing.string() + ": cannot open", 0), 0u) << error;
+}
+
+TEST(DurableFileTest, WriteWholeFileReplacesTheContentAndReportsAFullDisk) {
+  const ScopedTempDir dir("durable_whole");
+  const fs::path path = dir / "image.bin";
+  EXPECT_EQ(writeWholeFile(path, "a longer first content"), "");
+  EXPECT_EQ(writeWholeFile(path, "short"), "");
+  EXPECT_EQ(read(path), "short");
+  // /dev/full fails every write with ENOSPC: the disk-full case, without filling a disk.
+  const std::string full = writeWholeFile("/dev/full", "bytes that cannot land");
+  EXPECT_EQ(full.rfind("/dev/full: cannot write: ", 0), 0u) << full;
+  EXPECT_NE(full.find(std::strerror(ENOSPC)), std::string::npos) << full;
+  const fs::path missing = dir / "no" / "such" / "file.bin";
+  EXPECT_EQ(writeWholeFile(missing, "x").rfind(missing.string() + ": cannot create", 0), 0u);
 }
 
 TEST(DurableFileTest, AnAppenderKilledMidWriteLeavesEveryEarlierRecordWhole) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -119,6 +121,41 @@ TEST(Pfm, RoundTripKeepsFloatsAndOrientation) {
   EXPECT_EQ(cv::norm(*back, disparity, cv::NORM_INF), 0.0);
   EXPECT_FALSE(readPfm(dir / "absent.pfm"));
   EXPECT_FALSE(writePfm(dir / "x.pfm", cv::Mat(3, 3, CV_8UC1)));
+}
+
+TEST(Pfm, AFullDiskAndADamagedHeaderAreErrorsNamingTheFile) {
+  testing_support::ScopedTempDir dir("stereo_pfm_damage");
+  const cv::Mat disparity(64, 48, CV_32F, cv::Scalar(2.5f));
+  // /dev/full refuses every byte (ENOSPC), as a full disk does.
+  auto full = writePfm("/dev/full", disparity);
+  ASSERT_FALSE(full);
+  EXPECT_EQ(full.error().message.rfind("/dev/full: cannot write", 0), 0u) << full.error().message;
+
+  ASSERT_TRUE(writePfm(dir / "whole.pfm", disparity));
+  const auto size = std::filesystem::file_size(dir / "whole.pfm");
+  std::filesystem::copy_file(dir / "whole.pfm", dir / "cut.pfm");
+  std::filesystem::resize_file(dir / "cut.pfm", size / 2);
+  auto cut = readPfm(dir / "cut.pfm");
+  ASSERT_FALSE(cut);
+  EXPECT_NE(cut.error().message.find((dir / "cut.pfm").string() + ": PFM header says 48 x 64"),
+            std::string::npos)
+      << cut.error().message;
+  // A small file whose header asks for gigabytes is refused before anything is allocated.
+  {
+    std::ofstream huge(dir / "huge.pfm", std::ios::binary);
+    huge << "Pf\n30000 30000\n-1\n" << std::string(1000, '\0');
+  }
+  auto refused = readPfm(dir / "huge.pfm");
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("more than the file holds"), std::string::npos)
+      << refused.error().message;
+  {
+    std::ofstream text(dir / "text.pfm");
+    text << "not an image";
+  }
+  auto not_pfm = readPfm(dir / "text.pfm");
+  ASSERT_FALSE(not_pfm);
+  EXPECT_NE(not_pfm.error().message.find("not a PFM file"), std::string::npos);
 }
 
 StereoCalibration smallCalibration(cv::Size size) {

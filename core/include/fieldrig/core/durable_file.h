@@ -24,6 +24,11 @@ std::optional<std::string> readWholeFile(const std::filesystem::path& path, std:
 // old or the new content, never a mix. Empty on success, else "PATH: reason".
 std::string replaceFileAtomically(const std::filesystem::path& path, std::string_view text);
 
+// Writes `data` to `path` (created or truncated) and checks that every byte and the close went
+// through; no fsync: for outputs that are remade by running again (rendered images, maps).
+// Empty on success, else "PATH: reason".
+std::string writeWholeFile(const std::filesystem::path& path, std::string_view data);
+
 // Appends `text` (whole lines, by convention) to `path`, creating it, and waits until the data is
 // on the disk (fdatasync): after a crash the file holds every append that returned, and at most a
 // torn last line of one that did not. Empty on success, else "PATH: reason".
