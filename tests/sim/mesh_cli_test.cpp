@@ -4,6 +4,8 @@
 // renderer or a bad traits file are refused before anything is written, naming the flag or file.
 #include <gtest/gtest.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -104,6 +106,54 @@ TEST(MeshCli, OptionsThatDoNotFitTheRendererAreRefusedBeforeAnythingIsWritten) {
     EXPECT_NE(run.err.find(named), std::string::npos) << run.err;
     EXPECT_FALSE(fs::exists(out)) << "something was written";
   }
+}
+
+// A field is written whole into a new or empty folder: an earlier field, a file or a row count
+// the plots cannot fill are refused as bad input, naming the option, and nothing is touched.
+TEST(MeshCli, SimulateRefusesAFolderThatHoldsFilesAndRowsThePlotsCannotFill) {
+  ScopedTempDir dir("mesh_cli_out_folder");
+  const fs::path earlier = dir / "earlier";
+  fs::create_directories(earlier / "source-session");
+  { std::ofstream(earlier / "truth.jsonl") << "{\"plot\":\"R01P01\"}\n"; }
+  const fs::path file = dir / "a-file";
+  { std::ofstream(file) << "x"; }
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"simulate", "--out", earlier.string(), "--plots", "1", "--rows", "1"},
+       "--out: " + earlier.string() + ": already holds files"},
+      {{"simulate", "--out", file.string(), "--plots", "1", "--rows", "1"},
+       "--out: " + file.string() + ": exists and is not a folder"},
+      {{"simulate", "--out", "", "--plots", "1", "--rows", "1"}, "--out: an empty path"},
+      {{"simulate", "--out", (dir / "new").string(), "--plots", "1", "--rows", "2"},
+       "--rows 2 is more than --plots 1"},
+  };
+  for (const auto& [args, named] : cases) {
+    SCOPED_TRACE(named);
+    const auto run = runFieldrig(args, dir.path());
+    EXPECT_EQ(run.exit_code, 2) << run.err;
+    EXPECT_NE(run.err.find(named), std::string::npos) << run.err;
+  }
+  EXPECT_EQ(testing_support::readWholeFile(earlier / "truth.jsonl"), "{\"plot\":\"R01P01\"}\n");
+  EXPECT_TRUE(fs::is_empty(earlier / "source-session"));
+  EXPECT_FALSE(fs::exists(dir / "new"));
+}
+
+// A write that fails half-way (here the file size limit, as a full disk would) fails the run
+// with the file named, and leaves neither the field's folder nor its hidden staging folder.
+TEST(MeshCli, SimulateThatCannotWriteLeavesNothingHalfWritten) {
+  ScopedTempDir dir("mesh_cli_short_write");
+  const fs::path out = dir / "field";
+  // 4 MiB: the drive, map and frames fit, a 1624 × 1224 float depth map (7.9 MB) does not.
+  const auto run = testing_support::runProgram(
+      "bash",
+      {"-c", "trap '' XFSZ; ulimit -f 4096; exec \"$0\" \"$@\"", testing_support::kFieldrigBinary,
+       "simulate", "--out", out.string(), "--plots", "1", "--rows", "1", "--stage", "early"},
+      dir.path());
+  EXPECT_EQ(run.exit_code, 3) << run.err;
+  EXPECT_NE(run.err.find(".depth.pfm: cannot write: " + std::string(std::strerror(EFBIG))),
+            std::string::npos)
+      << run.err;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_FALSE(fs::exists(dir / ".field.simulate-partial"));
 }
 
 }  // namespace

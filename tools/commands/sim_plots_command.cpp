@@ -160,6 +160,13 @@ int runSimulate(const FieldArgs& args) {
     return fail("fieldrig simulate: ", *error);
   if (auto error = sim::validatePlotSeries(sim::fieldPlotSeries(spec, spec.plots)))
     return fail("fieldrig simulate: ", *error);
+  if (spec.rows > spec.plots) {
+    return fail("fieldrig simulate: ", "--rows " + std::to_string(spec.rows) +
+                                           " is more than --plots " + std::to_string(spec.plots) +
+                                           " (every row needs a plot)");
+  }
+  if (auto error = sim::checkFieldFolder(args.out))
+    return fail("fieldrig simulate: --out: ", *error);
   double seconds = 0.0;
   auto files = sim::writeSyntheticField(args.out, spec, [&](const sim::RecordedPlot& plot) {
     seconds += plot.render_seconds + plot.truth_seconds;

@@ -27,20 +27,29 @@ PlotSeries fieldPlotSeries(const FieldSpec& spec, int plots) {
   return series;
 }
 
-core::Result<FieldFiles> writeSyntheticField(
-    const fs::path& dir, const FieldSpec& spec,
-    const std::function<void(const RecordedPlot&)>& progress) {
-  if (spec.plots < 1 || spec.rows < 1 || spec.rows > spec.plots) {
-    return core::Error{"synthetic field: need 1 <= rows <= plots (got " +
-                       std::to_string(spec.rows) + " rows, " + std::to_string(spec.plots) +
-                       " plots)"};
-  }
-  if (auto error = validatePlotSeries(fieldPlotSeries(spec, spec.plots)))
-    return core::Error{"synthetic field: " + *error};
+std::optional<std::string> checkFieldFolder(const fs::path& dir) {
+  if (dir.empty())
+    return "an empty path";
   std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec)
-    return core::Error{dir.string() + ": cannot create folder: " + ec.message()};
+  const fs::file_status status = fs::status(dir, ec);
+  if (!fs::exists(status))
+    return std::nullopt;
+  if (!fs::is_directory(status))
+    return dir.string() + ": exists and is not a folder";
+  if (!fs::is_empty(dir, ec) || ec) {
+    return dir.string() +
+           ": already holds files (a field is written whole into a new or empty folder: remove "
+           "it or give another)";
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// The field's files in `dir` (which exists); `writeSyntheticField` puts them in place.
+core::Result<FieldFiles> writeFieldInto(const fs::path& dir, const FieldSpec& spec,
+                                        const std::function<void(const RecordedPlot&)>& progress) {
+  std::error_code ec;
   // Rows running north near Ames, Iowa: 3 m plots with 1 m alleys, 90-inch row spacing.
   gps::FieldPlan plan;
   plan.rows = spec.rows;
@@ -110,6 +119,54 @@ core::Result<FieldFiles> writeSyntheticField(
                 ec);
   if (ec)
     return core::Error{files.truth.string() + ": cannot write: " + ec.message()};
+  return files;
+}
+
+}  // namespace
+
+core::Result<FieldFiles> writeSyntheticField(
+    const fs::path& dir, const FieldSpec& spec,
+    const std::function<void(const RecordedPlot&)>& progress) {
+  if (spec.plots < 1 || spec.rows < 1 || spec.rows > spec.plots) {
+    return core::Error{"synthetic field: need 1 <= rows <= plots (got " +
+                       std::to_string(spec.rows) + " rows, " + std::to_string(spec.plots) +
+                       " plots)"};
+  }
+  if (auto error = validatePlotSeries(fieldPlotSeries(spec, spec.plots)))
+    return core::Error{"synthetic field: " + *error};
+  if (auto error = checkFieldFolder(dir))
+    return core::Error{*error};
+  // "out/" names the folder "out"; the hidden staging folder sits beside it, on the same file
+  // system, so that the final rename is atomic.
+  fs::path target = dir.lexically_normal();
+  if (target.filename().empty())
+    target = target.parent_path();
+  const fs::path staging =
+      target.parent_path() / ("." + target.filename().string() + ".simulate-partial");
+  std::error_code ec;
+  fs::remove_all(staging, ec);  // what a killed run left
+  fs::create_directories(staging, ec);
+  if (ec)
+    return core::Error{staging.string() + ": cannot create folder: " + ec.message()};
+  auto written = writeFieldInto(staging, spec, progress);
+  if (written) {
+    fs::remove(target, ec);  // an empty folder the caller made (rename cannot replace it)
+    ec.clear();
+    fs::rename(staging, target, ec);
+    if (ec)
+      written = core::Error{target.string() + ": cannot move the field in place from " +
+                            staging.string() + ": " + ec.message()};
+  }
+  if (!written) {
+    fs::remove_all(staging, ec);
+    return written.error();
+  }
+  FieldFiles files = *written;
+  files.nmea = dir / "drive.nmea";
+  files.map = dir / "map.csv";
+  files.session = dir / "source-session";
+  files.calibration = files.session / "calib";
+  files.truth = dir / "truth.jsonl";
   return files;
 }
 

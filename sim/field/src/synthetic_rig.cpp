@@ -8,7 +8,10 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
+#include <string_view>
+#include <vector>
 
+#include "fieldrig/core/durable_file.h"
 #include "fieldrig/recording/session_format.h"
 #include "fieldrig/recording/session_writer.h"
 #include "fieldrig/sim/mesh_renderer.h"
@@ -226,14 +229,18 @@ core::Result<Json> writeTruthMaps(const fs::path& session_dir, std::uint64_t set
        {std::pair{".plot.png", &frame.plot}, std::pair{".plant.png", &frame.plant},
         std::pair{".veg.png", &frame.vegetation}}) {
     const std::string file = base.string() + suffix;
-    bool ok = false;
+    // Encoded in memory and written by us: cv::imwrite says true after a short write.
+    std::vector<std::uint8_t> encoded;
     try {
-      ok = cv::imwrite(file, *image);
-    } catch (const cv::Exception&) {
-      ok = false;
+      if (!cv::imencode(".png", *image, encoded))
+        return core::Error{file + ": cannot encode PNG"};
+    } catch (const cv::Exception& e) {
+      return core::Error{file + ": cannot encode PNG: " + e.what()};
     }
-    if (!ok)
-      return core::Error{file + ": cannot write"};
+    if (std::string failed = core::writeWholeFile(
+            file, std::string_view(reinterpret_cast<const char*>(encoded.data()), encoded.size()));
+        !failed.empty())
+      return core::Error{std::move(failed)};
   }
   names["plot"] = stem + ".plot.png";
   names["plant"] = stem + ".plant.png";

@@ -144,8 +144,15 @@ struct FieldFiles {
 // The plot series of a field whose drive triggers `plots` locations.
 PlotSeries fieldPlotSeries(const FieldSpec& spec, int plots);
 
+// Why `dir` cannot take a new field (an empty path, something that is not a folder, a folder
+// that already holds files), or nullopt: a field is written whole into a new or empty folder,
+// never mixed into an earlier one.
+std::optional<std::string> checkFieldFolder(const std::filesystem::path& dir);
+
 // DIR/drive.nmea, DIR/map.csv, DIR/source-session (with calib/ and truth.jsonl), DIR/truth.jsonl.
-// The spec is checked (validatePlotSeries) before anything is written.
+// The spec and the folder (checkFieldFolder) are checked before anything is written. The field is
+// written into a hidden folder beside DIR and renamed to DIR when it is whole; on an error that
+// folder is removed, so nothing half-written is left.
 core::Result<FieldFiles> writeSyntheticField(
     const std::filesystem::path& dir, const FieldSpec& spec,
     const std::function<void(const RecordedPlot&)>& progress = {});
