@@ -68,7 +68,8 @@ std::filesystem::path truthMapPath(const recording::SessionReader& reader,
 
 core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uint64_t set_index,
                                 const cloud::RigCalibration& rig, TruthMaps maps,
-                                std::vector<cloud::HeadFrames>& frames) {
+                                std::vector<cloud::HeadFrames>& frames,
+                                std::vector<std::string>& problems) {
   const recording::IndexedSet* set = reader.bySetIndex(set_index);
   if (!set)
     return core::Error{reader.dir().string() + ": no set with index " + std::to_string(set_index)};
@@ -80,9 +81,10 @@ core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uin
       const std::filesystem::path path = truthMapPath(reader, *lefts[i], suffix);
       if (suffix == ".depth.pfm") {
         core::Result<cv::Mat> depth = stereo::readPfm(path);
-        if (!depth)
-          return core::Error{"truth depth map " + depth.error().message};
-        frames[i].left_truth_depth = std::move(*depth);
+        if (depth)
+          frames[i].left_truth_depth = std::move(*depth);
+        else
+          problems.push_back("truth depth map " + depth.error().message);
         continue;
       }
       cv::Mat mask;
@@ -92,8 +94,9 @@ core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uin
         mask.release();
       }
       if (mask.empty())
-        return core::Error{path.string() + ": truth vegetation mask missing or unreadable"};
-      frames[i].left_truth_vegetation = std::move(mask);
+        problems.push_back(path.string() + ": truth vegetation mask missing or unreadable");
+      else
+        frames[i].left_truth_vegetation = std::move(mask);
     }
   }
   return {};

@@ -35,8 +35,8 @@ core::Result<SessionProcessingSummary> processSession(
     std::vector<std::string> problems;
     auto frames = headFramesFromRecording(reader, set.set_index, processor.rig(), problems);
     if (frames && options.truth_maps != TruthMaps::kNone) {
-      if (auto added =
-              addTruthMaps(reader, set.set_index, processor.rig(), options.truth_maps, *frames);
+      if (auto added = addTruthMaps(reader, set.set_index, processor.rig(), options.truth_maps,
+                                    *frames, problems);
           !added)
         return added.error();
     }

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -157,6 +158,36 @@ TEST(ProcessTruthDepthCli, TruthWhereMatchedKeepsStereosPixelsWithTheTruthsDepth
   EXPECT_EQ(on_surface.at("on_sky_fraction").get<double>(), 0.0) << on_surface.dump();
   EXPECT_GT(stereo_bottom.at("points_vs_truth").at("off_surface_3cm_fraction").get<double>(),
             on_surface.at("off_surface_3cm_fraction").get<double>());
+}
+
+// A truth map damaged after the session was checked costs its head, not the run: the set's line
+// names the file among its problems, and the other heads are processed and scored.
+TEST(ProcessTruthDepthCli, ADamagedTruthMapIsNamedOnItsSetAndTheRunGoesOn) {
+  ScopedTempDir dir("process_truth_depth_damaged");
+  const fs::path session = renderedSession(dir);
+  ASSERT_FALSE(HasFailure());
+  const fs::path depth = session / "frames" / "000000_2_middle_left.depth.pfm";
+  fs::resize_file(depth, fs::file_size(depth) / 2);
+  { std::ofstream(session / "frames" / "000000_4_top_left.veg.png") << "not a PNG"; }
+
+  auto problemNaming = [](const Json& line, const std::string& file) {
+    for (const Json& problem : line.at("problems")) {
+      if (problem.get<std::string>().find(file) != std::string::npos)
+        return true;
+    }
+    return false;
+  };
+  const Json t = processedLine(dir, session, "truth", {"--depth-source", "truth"});
+  ASSERT_FALSE(t.is_null());
+  EXPECT_TRUE(problemNaming(t, "000000_2_middle_left.depth.pfm: PFM header says")) << t.dump();
+  EXPECT_EQ(head(t, "middle").at("points"), 0) << t.dump();
+  EXPECT_GT(head(t, "bottom").at("points").get<double>(), 0.0);
+
+  const Json s = processedLine(dir, session, "stereo", {"--score-stereo"});
+  ASSERT_FALSE(s.is_null());
+  EXPECT_TRUE(problemNaming(s, "000000_4_top_left.veg.png")) << s.dump();
+  EXPECT_TRUE(head(s, "bottom").contains("stereo_vs_truth")) << s.dump();
+  EXPECT_FALSE(head(s, "top").contains("stereo_vs_truth")) << s.dump();
 }
 
 TEST(ProcessTruthDepthCli, ASessionWithoutTruthMapsIsRefusedNamingTheMissingFile) {

@@ -32,11 +32,14 @@ std::filesystem::path truthMapPath(const recording::SessionReader& reader,
                                    const recording::IndexedFrame& frame, const std::string& suffix);
 
 // Adds the truth maps of each head's left camera in set `set_index` to `frames` (in the order of
-// rig.heads). A head whose left frame was not recorded is skipped (it has no image either). The
-// error names the first file that is missing or unreadable.
+// rig.heads). A head whose left frame was not recorded is skipped (it has no image either). A map
+// that is missing or unreadable is left out and named in `problems` (the head then goes without
+// it: in a truth depth mode it gives no points, and it is not scored); only a set that does not
+// exist is an error.
 core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uint64_t set_index,
                                 const cloud::RigCalibration& rig, TruthMaps maps,
-                                std::vector<cloud::HeadFrames>& frames);
+                                std::vector<cloud::HeadFrames>& frames,
+                                std::vector<std::string>& problems);
 
 // Whether every recorded left frame of the session has its truth maps on disk, checked before
 // processing starts; the error names the first missing file and says where they come from.
