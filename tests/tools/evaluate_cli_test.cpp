@@ -181,6 +181,15 @@ TEST_F(EvaluateCli, BadFilesAreNamedWithTheLineAndField) {
        {truthLine("A", 1, 0.5, 0.4), truthLine("A", 1, 0.5, 0.4)},
        "truth.jsonl:2: plot A appears twice"},
       {"empty", {}, "truth.jsonl: no plots"},
+      {"no traits at all",
+       {Json{{"plot", "A"}, {"set", 0}}.dump()},
+       "truth.jsonl:1: plot A: status ok but none of height_m, width_m, vvi, vai is a number"},
+      {"traits not an object",
+       {Json{{"plot", "A"}, {"traits", "oops"}}.dump()},
+       "truth.jsonl:1: plot A: \"traits\" is not an object"},
+      {"status not a string",
+       {Json{{"plot", "A"}, {"status", 1}, {"height_m", 1.0}}.dump()},
+       "truth.jsonl:1: plot A: \"status\" is not a string"},
   };
   for (const Case& c : cases) {
     writeLines(truth, c.truth_lines);

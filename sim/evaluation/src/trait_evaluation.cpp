@@ -30,14 +30,24 @@ core::Result<PlotTraitValues> plotFromJson(const Json& object, const std::string
     return core::Error{where + ": no \"plot\" (or \"location\") id"};
   // Results nest the traits under "traits"; truth lines hold them at the top, and other
   // definitions of the truth in their own object.
-  const auto nested = object.find(block.empty() ? "traits" : block);
+  const std::string nested_name = block.empty() ? "traits" : block;
+  const auto nested = object.find(nested_name);
   if (!block.empty() && (nested == object.end() || !nested->is_object()))
     return core::Error{where + ": plot " + plot.plot + ": no \"" + block +
                        "\" object (a truth written before it existed: simulate the field again)"};
-  const Json& traits = nested != object.end() && nested->is_object() ? *nested : object;
-  if (const auto status = traits.find("status"); status != traits.end() && status->is_string())
+  // A "traits" that is there but not an object is damage, not a truth line's flat layout.
+  if (nested != object.end() && !nested->is_object())
+    return core::Error{where + ": plot " + plot.plot + ": \"" + nested_name +
+                       "\" is not an object"};
+  const Json& traits = nested != object.end() ? *nested : object;
+  if (const auto status = traits.find("status"); status != traits.end()) {
+    if (!status->is_string())
+      return core::Error{where + ": plot " + plot.plot + ": \"status\" is not a string"};
     plot.status = status->get<std::string>();
+  }
+  std::string names;
   for (const ComparedTrait& trait : kComparedTraits) {
+    names += (names.empty() ? "" : ", ") + std::string(trait.name);
     const auto value = traits.find(trait.name);
     if (value == traits.end() || value->is_null())
       continue;
@@ -46,6 +56,11 @@ core::Result<PlotTraitValues> plotFromJson(const Json& object, const std::string
                          "\" is not a finite number"};
     plot.traits[trait.name] = value->get<double>();
   }
+  // A plot said to be ok must carry something to compare, or it would count as scored with
+  // nothing compared (a failed plot's traits are null by design).
+  if (plot.status == "ok" && plot.traits.empty())
+    return core::Error{where + ": plot " + plot.plot + ": status ok but none of " + names +
+                       " is a number"};
   return plot;
 }
 
