@@ -122,7 +122,7 @@ TEST(MeshCli, SimulateRefusesAFolderThatHoldsFilesAndRowsThePlotsCannotFill) {
        "--out: " + earlier.string() + ": already holds files"},
       {{"simulate", "--out", file.string(), "--plots", "1", "--rows", "1"},
        "--out: " + file.string() + ": exists and is not a folder"},
-      {{"simulate", "--out", "", "--plots", "1", "--rows", "1"}, "--out: an empty path"},
+      {{"simulate", "--out", "", "--plots", "1", "--rows", "1"}, "--out: must not be empty"},
       {{"simulate", "--out", (dir / "new").string(), "--plots", "1", "--rows", "2"},
        "--rows 2 is more than --plots 1"},
   };

@@ -66,6 +66,16 @@ TEST(RunCommandLine, GivesTheRunsExitCode) {
   EXPECT_EQ(failed.err, "");
 }
 
+// A command reads an empty string option as "not given"; an empty value must not pass for that.
+TEST(RunCommandLine, AnEmptyValueIsRefusedNamingTheOption) {
+  const Outcome empty = runWith({"sim", "drive", "--what", ""});
+  EXPECT_EQ(empty.exit_code, kExitBadInput);
+  EXPECT_EQ(empty.err,
+            "fieldrig sim drive: --what: must not be empty (fieldrig sim drive --help lists the "
+            "options)\n");
+  EXPECT_EQ(runWith({"sim", "drive", "--what", "x"}).exit_code, kExitOk);
+}
+
 TEST(RunCommandLine, AnOptionCli11RefusesIsOneLineNamingTheCommand) {
   const Outcome nan = runWith({"sim", "drive", "--rate", "nan"});
   EXPECT_EQ(nan.exit_code, kExitBadInput);

@@ -116,6 +116,24 @@ inline void addLogLevelOption(CLI::App& app, std::string& log_level) {
   app.parse_complete_callback([&log_level] { core::setupLogging(log_level); });
 }
 
+// An empty value ("--shard ''", "--out ''", an empty positional) is refused for every option
+// that takes one, here and its subcommands': the commands test their string options for
+// emptiness to mean "not given", so an empty value would silently act as no option at all
+// (`--shard ''` processed every set in every array task).
+inline void refuseEmptyValues(CLI::App& app) {
+  const CLI::Validator non_empty(
+      [](std::string& input) {
+        return input.empty() ? std::string("must not be empty") : std::string{};
+      },
+      "");
+  for (CLI::Option* option : app.get_options()) {
+    if (option->get_type_size_max() > 0)
+      option->check(non_empty);
+  }
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    refuseEmptyValues(*sub);
+}
+
 // main(): parses the command line, whose subcommand callbacks run the command and set
 // `exit_code`, and gives the process's exit code. Whatever fails says so in one stderr line that
 // names the command: an option CLI11 refuses (exit 2; --help is exit 0), or an exception that
@@ -123,6 +141,7 @@ inline void addLogLevelOption(CLI::App& app, std::string& log_level) {
 inline int runCommandLine(CLI::App& app, const std::string& program, int argc,
                           const char* const* argv, const int& exit_code) {
   try {
+    refuseEmptyValues(app);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0)
