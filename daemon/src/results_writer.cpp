@@ -98,6 +98,19 @@ nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::Pl
   return line;
 }
 
+namespace {
+
+template <typename Line>
+ResultsWriter::DoneSet doneSet(const Line& line) {
+  ResultsWriter::DoneSet done;
+  if (const auto location = line.find("location"); location != line.end() && location->is_string())
+    done.location = location->template get<std::string>();
+  done.time = line.at("time").template get<std::string>();
+  return done;
+}
+
+}  // namespace
+
 core::Result<std::unique_ptr<ResultsWriter>> ResultsWriter::open(const std::filesystem::path& dir,
                                                                  ResultsOptions options) {
   std::error_code ec;
@@ -129,7 +142,7 @@ core::Result<std::unique_ptr<ResultsWriter>> ResultsWriter::open(const std::file
       if (!row)
         throw std::runtime_error(row.error().message);
       writer->rows_.push_back(std::move(*row));
-      writer->done_.insert(line.at("trigger_id").get<std::uint64_t>());
+      writer->done_[line.at("trigger_id").get<std::uint64_t>()] = doneSet(line);
     } catch (const std::exception& e) {
       return core::Error{lines_path.string() + ":" + std::to_string(line_number) +
                          ": not a result line: " + e.what()};
@@ -162,7 +175,7 @@ std::string ResultsWriter::add(const nlohmann::ordered_json& line) {
   if (!row)
     return row.error().message;
   rows_.push_back(std::move(*row));
-  done_.insert(line.at("trigger_id").get<std::uint64_t>());
+  done_[line.at("trigger_id").get<std::uint64_t>()] = doneSet(line);
   tables_stale_ = true;
   if (std::chrono::steady_clock::now() - tables_written_ >= options_.table_interval)
     return writeTables();

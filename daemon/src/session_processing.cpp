@@ -1,6 +1,7 @@
 #include "fieldrig/daemon/session_processing.h"
 
 #include <algorithm>
+#include <set>
 
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
@@ -17,6 +18,31 @@ std::filesystem::path defaultResultsDir(const std::filesystem::path& session_dir
   return dir;
 }
 
+core::Result<void> checkResultsMatchSession(const recording::SessionReader& reader,
+                                            const ResultsWriter& results) {
+  // Resuming skips the sets whose trigger ids the results hold: only right when the results are
+  // of this session. Results of another one (an --out given twice) would skip its sets unseen.
+  for (const recording::IndexedSet& set : reader.sets()) {
+    const auto done = results.done().find(set.trigger_id);
+    if (done == results.done().end())
+      continue;
+    const std::string time = core::formatIso8601(set.trigger_time, 6);
+    const std::string location = set.location_id.value_or("");
+    // A manual trigger's line may carry the rig's send time where the index has the host's.
+    const bool times_differ = !location.empty() && done->second.time != time;
+    if (done->second.location != location || times_differ) {
+      return core::Error{resultsFiles(results.dir()).jsonl.string() + ": trigger " +
+                         std::to_string(set.trigger_id) + " is " +
+                         (done->second.location.empty() ? "no location" : done->second.location) +
+                         " at " + done->second.time + " there but " +
+                         (location.empty() ? "no location" : location) + " at " + time + " in " +
+                         reader.dir().string() +
+                         ": results of another session (give another results folder, or --force)"};
+    }
+  }
+  return {};
+}
+
 core::Result<SessionProcessingSummary> processSession(
     const recording::SessionReader& reader, pipeline::PlotProcessor& processor,
     const gps::LocationMap* map, ResultsWriter& results, const SessionProcessingOptions& options,
@@ -24,10 +50,19 @@ core::Result<SessionProcessingSummary> processSession(
     const std::function<void(const std::string&)>& on_problem) {
   SessionProcessingSummary summary;
   const std::size_t end = std::min(reader.sets().size(), options.end_position);
+  if (auto matches = checkResultsMatchSession(reader, results); !matches)
+    return matches.error();
+  std::set<std::uint64_t> triggers_seen;
   for (std::size_t position = options.first_position; position < end; ++position) {
     const recording::IndexedSet& set = reader.sets()[position];
     if (position % options.shard_count != options.shard_index)
       continue;
+    if (!triggers_seen.insert(set.trigger_id).second) {
+      on_problem(reader.dir().string() + ": set " + std::to_string(set.set_index) +
+                 " has trigger id " + std::to_string(set.trigger_id) +
+                 ", as an earlier set has: a damaged index; not processed");
+      continue;
+    }
     if (results.contains(set.trigger_id)) {
       ++summary.already_done;
       continue;

@@ -11,6 +11,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 
 #include "support/cli_run.h"
 #include "support/temp_dir.h"
@@ -165,6 +166,28 @@ TEST(ProcessCli, ResumesSkipsWhatIsDoneRedoesWithForceAndSplitsIntoShards) {
   EXPECT_EQ(sets, (std::set<std::uint64_t>{0, 1, 2}));
   EXPECT_TRUE(fs::exists(session / "results" / "shard-0-of-2" / "plots.jsonl"));
   EXPECT_TRUE(fs::exists(session / "results" / "shard-1-of-2" / "plots.jsonl"));
+  // Results of another session in --out (here: a trigger at another time) are refused before
+  // anything is processed; resuming into them would skip those sets unseen.
+  const fs::path other = dir.path() / "other-results";
+  fs::create_directories(other);
+  {
+    std::istringstream lines(results);
+    std::ofstream out(other / "plots.jsonl");
+    std::string text;
+    std::getline(lines, text);
+    Json changed = Json::parse(text);
+    changed["time"] = "2001-01-01T00:00:00.000000Z";
+    out << changed.dump() << '\n';
+  }
+  const std::string other_before = readWholeFile(other / "plots.jsonl");
+  const auto mixed =
+      runFieldrig({"process", session.string(), "--out", other.string()}, dir.path());
+  EXPECT_EQ(mixed.exit_code, 2) << mixed.err;
+  EXPECT_NE(mixed.err.find((other / "plots.jsonl").string() + ": trigger "), std::string::npos)
+      << mixed.err;
+  EXPECT_NE(mixed.err.find("results of another session"), std::string::npos) << mixed.err;
+  EXPECT_TRUE(mixed.out_lines.empty());
+  EXPECT_EQ(readWholeFile(other / "plots.jsonl"), other_before);
   const auto bad = runFieldrig({"process", session.string(), "--shard", "2/2"}, dir.path());
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--shard"), std::string::npos) << bad.err;

@@ -114,6 +114,8 @@ int runProcess(const ProcessArgs& args) {
   auto results = daemon::ResultsWriter::open(out_dir);
   if (!results)
     return fail(who, results.error().message);
+  if (auto matches = daemon::checkResultsMatchSession(reader, **results); !matches)
+    return fail(who, matches.error().message);
   if (args.clouds)
     run.clouds_dir = out_dir;
   auto done = daemon::processSession(

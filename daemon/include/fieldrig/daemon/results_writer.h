@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -73,7 +74,13 @@ class ResultsWriter {
                                                            ResultsOptions options = {});
   ~ResultsWriter();
 
+  // What a result line says of its set, to tell a resumed session from another one.
+  struct DoneSet {
+    std::string location;  // empty: none
+    std::string time;      // the trigger time as the line has it
+  };
   bool contains(std::uint64_t trigger_id) const { return done_.count(trigger_id) > 0; }
+  const std::map<std::uint64_t, DoneSet>& done() const { return done_; }
   std::size_t plots() const { return rows_.size(); }
   const std::filesystem::path& dir() const { return dir_; }
 
@@ -90,7 +97,7 @@ class ResultsWriter {
   std::filesystem::path dir_;
   ResultsOptions options_;
   std::vector<traits::PlotRow> rows_;
-  std::set<std::uint64_t> done_;
+  std::map<std::uint64_t, DoneSet> done_;
   bool tables_stale_ = false;
   std::chrono::steady_clock::time_point tables_written_{};
 };

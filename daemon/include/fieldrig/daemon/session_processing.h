@@ -33,8 +33,9 @@ struct SessionProcessingOptions {
   // Also write each set's fused cloud here as PLOT_setN.ply (the processor must keep_cloud).
   std::optional<std::filesystem::path> clouds_dir;
   // The simulator's truth maps to hand the processor with each set (head_frames.h): the depth for
-  // cloud::DepthSource::kTruth, depth and vegetation to score stereo. A set whose maps cannot be
-  // read stops the run with an error naming the file (check them first: checkTruthMaps).
+  // cloud::DepthSource::kTruth, depth and vegetation to score stereo. A map that cannot be read
+  // is named in its set's problems and its head goes without it (check first that they are
+  // there: checkTruthMaps).
   TruthMaps truth_maps = TruthMaps::kNone;
 };
 
@@ -51,9 +52,18 @@ struct SessionProcessingSummary {
   std::size_t already_done = 0;  // skipped: in the results before this run
 };
 
+// Resuming skips the sets whose trigger ids the results hold, which is only right for results of
+// this session: the error names the results file and a trigger whose location or trigger time
+// differs there (results of another session, e.g. the same --out given for two sessions).
+core::Result<void> checkResultsMatchSession(const recording::SessionReader& reader,
+                                            const ResultsWriter& results);
+
 // `on_line` sees each set's result line before it is added to `results`; `on_problem` hears of a
-// cloud that cannot be written. The error names a results file that cannot be written (the run
-// stops there). `map` may be null.
+// cloud that cannot be written, and of a set whose trigger id an earlier set of the index already
+// has (a damaged index: only the first is processed). The error names a results file that cannot
+// be written (the run stops there), or results of another session: a line whose trigger id is a
+// set's here but whose location or trigger time is not (nothing is processed then). `map` may be
+// null.
 core::Result<SessionProcessingSummary> processSession(
     const recording::SessionReader& reader, pipeline::PlotProcessor& processor,
     const gps::LocationMap* map, ResultsWriter& results, const SessionProcessingOptions& options,
