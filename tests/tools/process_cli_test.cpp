@@ -193,6 +193,25 @@ TEST(ProcessCli, ResumesSkipsWhatIsDoneRedoesWithForceAndSplitsIntoShards) {
   EXPECT_NE(bad.err.find("--shard"), std::string::npos) << bad.err;
 }
 
+// A set whose index line a crash cut short is not in the session: the run says so, naming the
+// line, instead of the set vanishing from the results unremarked.
+TEST(ProcessCli, ATornLastIndexLineIsNamed) {
+  ScopedTempDir dir("process_cli_torn_index");
+  const fs::path session = dir.path() / "session";
+  ASSERT_EQ(runFieldrig({"sim", "plots", "--out", session.string(), "--count", "2"}, dir.path())
+                .exit_code,
+            0);
+  fs::resize_file(session / "index.jsonl", fs::file_size(session / "index.jsonl") - 50);
+  const auto run = runFieldrig({"process", session.string()}, dir.path());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find((session / "index.jsonl").string() + ":2: a torn last line"),
+            std::string::npos)
+      << run.err;
+  const Json summary = Json::parse(run.out_lines.back()).at("summary");
+  EXPECT_EQ(summary.at("sets"), 1);
+  EXPECT_EQ(summary.at("torn_index_line"), 2);
+}
+
 TEST(ProcessCli, BadCalibrationIsAClearError) {
   ScopedTempDir dir("process_cli_badcal");
   const fs::path session = dir.path() / "session";

@@ -60,6 +60,13 @@ int runProcess(const ProcessArgs& args) {
   if (!opened)
     return fail(who, opened.error().message);
   const recording::SessionReader& reader = *opened;
+  // A crash while a set was being indexed leaves a torn last line: that set is left out, and
+  // said so here rather than vanishing from the results.
+  if (const auto& torn = reader.tornLine()) {
+    std::cerr << who << (reader.dir() / recording::kIndexFile).string() << ":" << torn->line
+              << ": a torn last line (" << torn->bytes
+              << " bytes, a write cut short): its set is left out\n";
+  }
   auto rig = daemon::loadRigFor(args.calib, &reader);
   if (!rig)
     return fail(who, rig.error().message);
@@ -130,6 +137,7 @@ int runProcess(const ProcessArgs& args) {
   summary["partial_clouds"] = done->partial_clouds;
   summary["unplaced"] = done->unplaced;
   summary["already_done"] = done->already_done;
+  summary["torn_index_line"] = reader.tornLine() ? Json(reader.tornLine()->line) : Json(nullptr);
   summary["plots_in_results"] = (*results)->plots();
   const daemon::ResultsFiles files = daemon::resultsFiles(out_dir);
   summary["csv"] = files.csv.string();
