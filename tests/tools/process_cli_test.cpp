@@ -35,6 +35,16 @@ std::map<std::string, Json> readTruth(const fs::path& file) {
   return truth;
 }
 
+// `fieldrig sim plots --out SESSION --count N`: whether it succeeded.
+::testing::AssertionResult recordPlots(const ScopedTempDir& dir, const fs::path& session,
+                                       int count) {
+  const auto made = runFieldrig(
+      {"sim", "plots", "--out", session.string(), "--count", std::to_string(count)}, dir.path());
+  if (made.exit_code == 0)
+    return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "sim plots: exit " << made.exit_code << ": " << made.err;
+}
+
 TEST(ProcessCli, SyntheticSessionGivesTraitsCloseToTruth) {
   ScopedTempDir dir("process_cli_truth");
   const fs::path session = dir.path() / "session";
@@ -96,9 +106,7 @@ TEST(ProcessCli, SyntheticSessionGivesTraitsCloseToTruth) {
 TEST(ProcessCli, AMissingCameraGivesAFlaggedPartialPlotNotAFailure) {
   ScopedTempDir dir("process_cli_missing");
   const fs::path session = dir.path() / "session";
-  ASSERT_EQ(runFieldrig({"sim", "plots", "--out", session.string(), "--count", "1"}, dir.path())
-                .exit_code,
-            0);
+  ASSERT_TRUE(recordPlots(dir, session, 1));
   // The top head's right frame is lost (as a crash or a full disk would lose it).
   int removed = 0;
   for (const auto& entry : fs::directory_iterator(session / "frames")) {
@@ -127,9 +135,7 @@ TEST(ProcessCli, AMissingCameraGivesAFlaggedPartialPlotNotAFailure) {
 TEST(ProcessCli, ResumesSkipsWhatIsDoneRedoesWithForceAndSplitsIntoShards) {
   ScopedTempDir dir("process_cli_resume");
   const fs::path session = dir.path() / "session";
-  ASSERT_EQ(runFieldrig({"sim", "plots", "--out", session.string(), "--count", "3"}, dir.path())
-                .exit_code,
-            0);
+  ASSERT_TRUE(recordPlots(dir, session, 3));
   const auto first = runFieldrig({"process", session.string()}, dir.path());
   ASSERT_EQ(first.exit_code, 0) << first.err;
   const std::string results = readWholeFile(session / "results" / "plots.jsonl");
@@ -198,9 +204,7 @@ TEST(ProcessCli, ResumesSkipsWhatIsDoneRedoesWithForceAndSplitsIntoShards) {
 TEST(ProcessCli, ATornLastIndexLineIsNamed) {
   ScopedTempDir dir("process_cli_torn_index");
   const fs::path session = dir.path() / "session";
-  ASSERT_EQ(runFieldrig({"sim", "plots", "--out", session.string(), "--count", "2"}, dir.path())
-                .exit_code,
-            0);
+  ASSERT_TRUE(recordPlots(dir, session, 2));
   fs::resize_file(session / "index.jsonl", fs::file_size(session / "index.jsonl") - 50);
   const auto run = runFieldrig({"process", session.string()}, dir.path());
   ASSERT_EQ(run.exit_code, 0) << run.err;
@@ -215,9 +219,7 @@ TEST(ProcessCli, ATornLastIndexLineIsNamed) {
 TEST(ProcessCli, BadCalibrationIsAClearError) {
   ScopedTempDir dir("process_cli_badcal");
   const fs::path session = dir.path() / "session";
-  ASSERT_EQ(runFieldrig({"sim", "plots", "--out", session.string(), "--count", "1"}, dir.path())
-                .exit_code,
-            0);
+  ASSERT_TRUE(recordPlots(dir, session, 1));
   fs::remove(session / "calib" / "middle" / "extrinsics.yml");
   const auto run = runFieldrig({"process", session.string()}, dir.path());
   EXPECT_EQ(run.exit_code, 2);
@@ -231,9 +233,7 @@ TEST(ProcessCli, BadCalibrationIsAClearError) {
 TEST(ProcessCli, ConfigFileSetsTheProcessingOptions) {
   ScopedTempDir dir("process_cli_config");
   const fs::path session = dir.path() / "session";
-  ASSERT_EQ(runFieldrig({"sim", "plots", "--out", session.string(), "--count", "1"}, dir.path())
-                .exit_code,
-            0);
+  ASSERT_TRUE(recordPlots(dir, session, 1));
   const fs::path config = dir.path() / "near.yaml";
   std::ofstream(config) << "pipeline:\n  cloud:\n    min_depth_m: 0.3\n    max_depth_m: 0.5\n";
   const auto near = runFieldrig({"process", session.string(), "--config", config.string(), "--out",
