@@ -3,12 +3,9 @@
 #include <bit>
 #include <cerrno>
 #include <cmath>
-#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
-#include <string_view>
-#include <vector>
 
 #include "fieldrig/core/durable_file.h"
 

@@ -46,6 +46,15 @@ std::optional<std::string> checkFieldFolder(const fs::path& dir) {
 
 namespace {
 
+// Where a field's files are in folder `dir`.
+void placeFieldFiles(const fs::path& dir, FieldFiles& files) {
+  files.nmea = dir / "drive.nmea";
+  files.map = dir / "map.csv";
+  files.session = dir / "source-session";
+  files.calibration = files.session / "calib";
+  files.truth = dir / "truth.jsonl";
+}
+
 // The field's files in `dir` (which exists); `writeSyntheticField` puts them in place.
 core::Result<FieldFiles> writeFieldInto(const fs::path& dir, const FieldSpec& spec,
                                         const std::function<void(const RecordedPlot&)>& progress) {
@@ -73,11 +82,7 @@ core::Result<FieldFiles> writeFieldInto(const fs::path& dir, const FieldSpec& sp
   drive_options.seed = spec.seed;
   const DriveSimulator drive(plan, drive_options);
   FieldFiles files;
-  files.nmea = dir / "drive.nmea";
-  files.map = dir / "map.csv";
-  files.session = dir / "source-session";
-  files.calibration = files.session / "calib";
-  files.truth = dir / "truth.jsonl";
+  placeFieldFiles(dir, files);
   files.locations = map->size();
   const std::string nmea = drive.nmea();
   {
@@ -162,11 +167,7 @@ core::Result<FieldFiles> writeSyntheticField(
     return written.error();
   }
   FieldFiles files = *written;
-  files.nmea = dir / "drive.nmea";
-  files.map = dir / "map.csv";
-  files.session = dir / "source-session";
-  files.calibration = files.session / "calib";
-  files.truth = dir / "truth.jsonl";
+  placeFieldFiles(dir, files);
   return files;
 }
 
