@@ -77,14 +77,26 @@ core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uin
   for (std::size_t i = 0; i < lefts.size() && i < frames.size(); ++i) {
     if (!lefts[i])
       continue;
+    // A map of another size than the camera's is of another rig or damaged: it would score, or
+    // stand in for, pixels it does not describe.
+    const cv::Size camera_size = rig.heads[i].stereo.image_size;
+    auto sizeMatches = [&](const cv::Mat& map, const std::filesystem::path& path) {
+      if (camera_size.empty() || map.size() == camera_size)
+        return true;
+      problems.push_back(path.string() + ": truth map is " + std::to_string(map.cols) + "x" +
+                         std::to_string(map.rows) + " but the " + rig.heads[i].name +
+                         " head's calibration is for " + std::to_string(camera_size.width) + "x" +
+                         std::to_string(camera_size.height) + ": left out");
+      return false;
+    };
     for (const std::string& suffix : truthSuffixes(maps)) {
       const std::filesystem::path path = truthMapPath(reader, *lefts[i], suffix);
       if (suffix == ".depth.pfm") {
         core::Result<cv::Mat> depth = stereo::readPfm(path);
-        if (depth)
-          frames[i].left_truth_depth = std::move(*depth);
-        else
+        if (!depth)
           problems.push_back("truth depth map " + depth.error().message);
+        else if (sizeMatches(*depth, path))
+          frames[i].left_truth_depth = std::move(*depth);
         continue;
       }
       cv::Mat mask;
@@ -95,7 +107,7 @@ core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uin
       }
       if (mask.empty())
         problems.push_back(path.string() + ": truth vegetation mask missing or unreadable");
-      else
+      else if (sizeMatches(mask, path))
         frames[i].left_truth_vegetation = std::move(mask);
     }
   }

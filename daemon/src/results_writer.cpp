@@ -77,6 +77,8 @@ nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::Pl
                                       {"median_abs_depth_error_m", score.median_abs_depth_error_m},
                                       {"median_depth_error_m", score.median_depth_error_m}};
     }
+    if (!head.truth_problem.empty())
+      head_json["truth_problem"] = head.truth_problem;
     if (head.cloud_score) {
       head_json["points_vs_truth"] = {
           {"points", head.cloud_score->points},

@@ -160,8 +160,9 @@ TEST(ProcessTruthDepthCli, TruthWhereMatchedKeepsStereosPixelsWithTheTruthsDepth
             on_surface.at("off_surface_3cm_fraction").get<double>());
 }
 
-// A truth map damaged after the session was checked costs its head, not the run: the set's line
-// names the file among its problems, and the other heads are processed and scored.
+// A truth map damaged after the session was checked, or of another rig's size, costs its head
+// (its truth, not its stereo), not the run: the set's line names the file among its problems, and
+// the other heads are processed and scored.
 TEST(ProcessTruthDepthCli, ADamagedTruthMapIsNamedOnItsSetAndTheRunGoesOn) {
   ScopedTempDir dir("process_truth_depth_damaged");
   const fs::path session = renderedSession(dir);
@@ -169,6 +170,10 @@ TEST(ProcessTruthDepthCli, ADamagedTruthMapIsNamedOnItsSetAndTheRunGoesOn) {
   const fs::path depth = session / "frames" / "000000_2_middle_left.depth.pfm";
   fs::resize_file(depth, fs::file_size(depth) / 2);
   { std::ofstream(session / "frames" / "000000_4_top_left.veg.png") << "not a PNG"; }
+  {  // a whole, readable map of another size: of another rig
+    std::ofstream small(session / "frames" / "000000_4_top_left.depth.pfm", std::ios::binary);
+    small << "Pf\n4 4\n-1\n" << std::string(4 * 4 * sizeof(float), '\0');
+  }
 
   auto problemNaming = [](const Json& line, const std::string& file) {
     for (const Json& problem : line.at("problems")) {
@@ -181,11 +186,15 @@ TEST(ProcessTruthDepthCli, ADamagedTruthMapIsNamedOnItsSetAndTheRunGoesOn) {
   ASSERT_FALSE(t.is_null());
   EXPECT_TRUE(problemNaming(t, "000000_2_middle_left.depth.pfm: PFM header says")) << t.dump();
   EXPECT_EQ(head(t, "middle").at("points"), 0) << t.dump();
+  EXPECT_TRUE(problemNaming(t, "000000_4_top_left.depth.pfm: truth map is 4x4")) << t.dump();
+  EXPECT_EQ(head(t, "top").at("points"), 0) << t.dump();
   EXPECT_GT(head(t, "bottom").at("points").get<double>(), 0.0);
 
   const Json s = processedLine(dir, session, "stereo", {"--score-stereo"});
   ASSERT_FALSE(s.is_null());
   EXPECT_TRUE(problemNaming(s, "000000_4_top_left.veg.png")) << s.dump();
+  EXPECT_TRUE(problemNaming(s, "000000_4_top_left.depth.pfm: truth map is 4x4")) << s.dump();
+  EXPECT_GT(head(s, "top").at("points").get<double>(), 0.0) << "stereo needs no truth";
   EXPECT_TRUE(head(s, "bottom").contains("stereo_vs_truth")) << s.dump();
   EXPECT_FALSE(head(s, "top").contains("stereo_vs_truth")) << s.dump();
 }

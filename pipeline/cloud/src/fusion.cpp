@@ -174,15 +174,21 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
         const stereo::TruthDepthRectifier& truth = heads_[i].truthDepth();
         core::Result<cv::Mat> disparity = truth.disparity(head.left_truth_depth);
         if (disparity && !head.left_truth_vegetation.empty()) {
-          if (core::Result<cv::Mat> vegetation = truth.rectifyMask(head.left_truth_vegetation))
+          core::Result<cv::Mat> vegetation = truth.rectifyMask(head.left_truth_vegetation);
+          if (vegetation) {
             status.stereo_score = truth.score(output->disparity, *disparity, *vegetation,
                                               options_.min_depth_m, options_.max_depth_m);
+          } else {
+            status.truth_problem = vegetation.error().message;
+          }
         }
         if (disparity) {
           truth_disparity = std::move(*disparity);
         } else if (truth_where_matched) {
           status.problem = disparity.error().message;
           return;
+        } else {
+          status.truth_problem = disparity.error().message;
         }
       }
       // The stereo score above stays the matcher's; everything after sees the truth's depth.

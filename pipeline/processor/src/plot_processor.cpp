@@ -24,6 +24,9 @@ PlotResult PlotProcessor::process(const std::vector<cloud::HeadFrames>& heads,
   for (const cloud::HeadStatus& head : fused.heads) {
     if (!head.ok)
       result.problems.push_back("head " + head.name + " left out: " + head.problem);
+    else if (!head.truth_problem.empty())
+      result.problems.push_back("head " + head.name +
+                                " not scored against the truth: " + head.truth_problem);
   }
   result.heads = fused.heads;
   result.cloud_points = fused.cloud.size();

@@ -138,6 +138,34 @@ TEST(CloudBuilder, WrongSizesFlagTheHead) {
   EXPECT_TRUE(result.heads[2].ok);
 }
 
+// Truth maps that do not fit the calibration cannot score the head; it says so and still
+// gives its points, while a head with fitting maps is scored.
+TEST(CloudBuilder, TruthMapsOfAnotherSizeLeaveTheHeadUnscoredAndSayWhy) {
+  const RigCalibration rig = syntheticRig();
+  auto builder = CloudBuilder::create(rig);
+  ASSERT_TRUE(builder);
+  std::vector<HeadFrames> frames = renderAll();
+  frames[0].left_truth_depth = cv::Mat(4, 4, CV_32F, cv::Scalar(2.0));
+  frames[0].left_truth_vegetation = cv::Mat(4, 4, CV_8UC1, cv::Scalar(1));
+  frames[1].left_truth_depth = cv::Mat(kCameraSize, CV_32F, cv::Scalar(2.0));
+  frames[1].left_truth_vegetation = cv::Mat(kCameraSize, CV_8UC1, cv::Scalar(1));
+  frames[2].left_truth_depth = cv::Mat(kCameraSize, CV_32F, cv::Scalar(2.0));
+  frames[2].left_truth_vegetation = cv::Mat(8, 8, CV_8UC1, cv::Scalar(1));
+  const FusionResult result = builder->build(frames);
+  EXPECT_TRUE(result.heads[0].ok);
+  EXPECT_GT(result.heads[0].points, 100000u);
+  EXPECT_FALSE(result.heads[0].stereo_score);
+  EXPECT_FALSE(result.heads[0].cloud_score);
+  EXPECT_NE(result.heads[0].truth_problem.find("truth depth map is 4x4"), std::string::npos)
+      << result.heads[0].truth_problem;
+  EXPECT_TRUE(result.heads[1].stereo_score);
+  EXPECT_EQ(result.heads[1].truth_problem, "");
+  EXPECT_FALSE(result.heads[2].stereo_score);
+  EXPECT_TRUE(result.heads[2].cloud_score) << "the depth fits: only the mask does not";
+  EXPECT_NE(result.heads[2].truth_problem.find("truth mask is 8x8"), std::string::npos)
+      << result.heads[2].truth_problem;
+}
+
 TEST(DepthEdges, BlendedPixelsAtAStepGoAndSlopesStay) {
   // Left half a leaf at 60 px, right half the background at 10 px, with SGBM's blend of the two
   // in the columns between; the rows below are a slanted surface (0.5 px per column).

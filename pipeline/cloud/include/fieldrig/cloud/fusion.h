@@ -48,6 +48,9 @@ struct HeadStatus {
   // rectified truth depth lies in (min_depth_m, max_depth_m] (about the plot frame's depth crop),
   // before the edge filter; bad = |disparity error| > 2 px at matching resolution.
   std::optional<stereo::DisparityTruthScore> stereo_score;
+  // Why a head that had truth maps was not scored against them (a map of another size than the
+  // calibration's): the head itself is in the cloud; only stereo_score or cloud_score is missing.
+  std::string truth_problem;
   // The same head's points (after the edge filter, in the depth range) against the truth.
   std::optional<stereo::CloudTruthScore> cloud_score;
   stereo::HeadTimings timings;
