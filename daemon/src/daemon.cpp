@@ -553,7 +553,7 @@ class Daemon {
       identity.location_id = event.location_id;
     identity.time =
         core::formatIso8601(event.location_id.empty() ? event.sent_time : event.time, 6);
-    identity.position = plotPosition(identity.location_id, event.fix, &map_);
+    placePlot(identity, event.fix, &map_);
     identity.trigger_status =
         event.location_id.empty() ? std::string() : std::string(core::toString(event.status));
     const Json line = plotLine(identity, result);

@@ -1,8 +1,10 @@
 #include "fieldrig/daemon/results_writer.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "fieldrig/core/durable_file.h"
+#include "fieldrig/gps/local_frame.h"
 
 namespace fieldrig::daemon {
 namespace {
@@ -26,16 +28,34 @@ void removeResults(const std::filesystem::path& dir) {
     std::filesystem::remove(file, ec);
 }
 
-std::optional<std::pair<double, double>> plotPosition(const std::optional<std::string>& location_id,
-                                                      const std::optional<core::GpsFix>& fix,
-                                                      const gps::LocationMap* map) {
-  if (map && location_id) {
-    if (const gps::ImagingLocation* location = map->find(*location_id))
-      return std::pair{location->latitude_deg, location->longitude_deg};
+void placePlot(PlotIdentity& identity, const std::optional<core::GpsFix>& fix,
+               const gps::LocationMap* map) {
+  identity.position.reset();
+  identity.placement_problem.reset();
+  const std::optional<std::string>& id = identity.location_id;
+  const gps::ImagingLocation* location = map && id ? map->find(*id) : nullptr;
+  if (location) {
+    identity.position = std::pair{location->latitude_deg, location->longitude_deg};
+    if (fix) {
+      const double metres =
+          gps::geodesicDistanceMetres({location->latitude_deg, location->longitude_deg},
+                                      {fix->latitude_deg, fix->longitude_deg});
+      if (metres > kMapToFixToleranceM) {
+        identity.placement_problem = "map location " + *id + " is " +
+                                     std::to_string(static_cast<long long>(std::lround(metres))) +
+                                     " m from the fix at the trigger: placed at the map's "
+                                     "location (a map of another field?)";
+      }
+    }
+    return;
   }
   if (fix)
-    return std::pair{fix->latitude_deg, fix->longitude_deg};
-  return std::nullopt;
+    identity.position = std::pair{fix->latitude_deg, fix->longitude_deg};
+  if (map && id) {
+    // Without a fix the line says, too, that it was placed at 0,0 (plotLine).
+    identity.placement_problem = "location " + *id + " is not in the map" +
+                                 (fix ? ": placed at the fix at the trigger" : "");
+  }
 }
 
 nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::PlotResult& result) {
@@ -48,6 +68,8 @@ nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::Pl
   line["location"] = optionalJson(identity.location_id);
   line["time"] = identity.time;
   std::vector<std::string> problems = result.problems;
+  if (identity.placement_problem)
+    problems.push_back(*identity.placement_problem);
   if (identity.position) {
     line["lat"] = identity.position->first;
     line["lon"] = identity.position->second;

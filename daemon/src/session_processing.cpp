@@ -1,10 +1,12 @@
 #include "fieldrig/daemon/session_processing.h"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
+#include "fieldrig/gps/local_frame.h"
 
 namespace fieldrig::daemon {
 
@@ -39,6 +41,55 @@ core::Result<void> checkResultsMatchSession(const recording::SessionReader& read
                          reader.dir().string() +
                          ": results of another session (give another results folder, or --force)"};
     }
+  }
+  return {};
+}
+
+core::Result<void> checkMapMatchesSession(const recording::SessionReader& reader,
+                                          const gps::LocationMap& map,
+                                          const std::string& map_name) {
+  const recording::IndexedSet* first_located = nullptr;
+  const recording::IndexedSet* first_far = nullptr;
+  double first_far_m = 0;
+  std::size_t in_map = 0, near = 0;
+  for (const recording::IndexedSet& set : reader.sets()) {
+    if (!set.location_id)
+      continue;
+    if (!first_located)
+      first_located = &set;
+    const gps::ImagingLocation* location = map.find(*set.location_id);
+    if (!location)
+      continue;
+    ++in_map;
+    if (!set.fix) {
+      ++near;  // nothing to hold it against: taken as the map says
+      continue;
+    }
+    const double metres =
+        gps::geodesicDistanceMetres({location->latitude_deg, location->longitude_deg},
+                                    {set.fix->latitude_deg, set.fix->longitude_deg});
+    if (metres <= kMapToFixToleranceM) {
+      ++near;
+    } else if (!first_far) {
+      first_far = &set;
+      first_far_m = metres;
+    }
+  }
+  if (!first_located)
+    return {};  // manual triggers only: the map places nothing
+  const std::string advice =
+      ": a map of another field? (without --map, plots are placed at the fix at their trigger)";
+  if (in_map == 0) {
+    return core::Error{map_name + ": holds none of the session's locations (the first, " +
+                       *first_located->location_id + ", of set " +
+                       std::to_string(first_located->set_index) + ", is not in it)" + advice};
+  }
+  if (near == 0) {
+    return core::Error{
+        map_name + ": every location of the session lies more than " +
+        std::to_string(static_cast<int>(kMapToFixToleranceM)) + " m from the fix at its trigger (" +
+        *first_far->location_id + " of set " + std::to_string(first_far->set_index) + ": " +
+        std::to_string(static_cast<long long>(std::lround(first_far_m))) + " m)" + advice};
   }
   return {};
 }
@@ -89,7 +140,7 @@ core::Result<SessionProcessingSummary> processSession(
     identity.trigger_id = set.trigger_id;
     identity.location_id = set.location_id;
     identity.time = core::formatIso8601(set.trigger_time, 6);
-    identity.position = plotPosition(set.location_id, set.fix, map);
+    placePlot(identity, set.fix, map);
     identity.trigger_status = set.trigger_status.value_or("");
     const nlohmann::ordered_json line = plotLine(identity, result);
     if (options.clouds_dir && frames) {
@@ -103,6 +154,7 @@ core::Result<SessionProcessingSummary> processSession(
     summary.ok += result.traits.status == traits::TraitsStatus::kOk ? 1 : 0;
     summary.partial_clouds += result.partial ? 1 : 0;
     summary.unplaced += identity.position ? 0 : 1;
+    summary.placement_problems += identity.placement_problem ? 1 : 0;
     on_line(line);
     if (std::string failed = results.add(line); !failed.empty())
       return core::Error{std::move(failed)};

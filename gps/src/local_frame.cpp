@@ -1,5 +1,6 @@
 #include "fieldrig/gps/local_frame.h"
 
+#include <GeographicLib/Geodesic.hpp>
 #include <cmath>
 #include <numbers>
 
@@ -20,6 +21,13 @@ GeodeticPoint LocalFrame::toGeodetic(const EnuPoint& point) const {
   double latitude = 0, longitude = 0, height = 0;
   cartesian_.Reverse(point.east_m, point.north_m, 0.0, latitude, longitude, height);
   return {latitude, longitude};
+}
+
+double geodesicDistanceMetres(const GeodeticPoint& a, const GeodeticPoint& b) {
+  double metres = 0;
+  GeographicLib::Geodesic::WGS84().Inverse(a.latitude_deg, a.longitude_deg, b.latitude_deg,
+                                           b.longitude_deg, metres);
+  return metres;
 }
 
 double bearingDegrees(double east, double north) {

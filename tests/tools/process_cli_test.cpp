@@ -216,6 +216,83 @@ TEST(ProcessCli, ATornLastIndexLineIsNamed) {
   EXPECT_EQ(summary.at("torn_index_line"), 2);
 }
 
+// A map of another field (none of the session's locations, or all of them elsewhere) is refused
+// before anything is written; a map that lacks or misplaces only some locations is used, and
+// those plots' lines say so.
+TEST(ProcessCli, AMapOfAnotherFieldIsRefusedAndAPlotItMisplacesIsSaid) {
+  ScopedTempDir dir("process_cli_map");
+  const fs::path session = dir.path() / "session";
+  ASSERT_TRUE(recordPlots(dir, session, 3));
+  std::map<std::string, std::pair<double, double>> fixes;  // where each plot was taken
+  {
+    std::ifstream index(session / "index.jsonl");
+    for (std::string text; std::getline(index, text);) {
+      const Json set = Json::parse(text);
+      fixes[set.at("location_id").get<std::string>()] = {set.at("gps").at("lat").get<double>(),
+                                                         set.at("gps").at("lon").get<double>()};
+    }
+  }
+  ASSERT_EQ(fixes.size(), 3U);
+  // A map row for `plot` at its fix moved `north_deg` degrees of latitude.
+  auto row = [&](const std::string& id, const std::string& plot, double north_deg) {
+    std::ostringstream out;
+    out.precision(12);
+    out << id << ',' << fixes.at(plot).first + north_deg << ',' << fixes.at(plot).second << ",0\n";
+    return out.str();
+  };
+  auto writeMap = [&](const std::string& name, const std::string& rows) {
+    const fs::path map = dir.path() / name;
+    std::ofstream(map) << "id,lat,lon,heading\n" << rows;
+    return map;
+  };
+  auto process = [&](const fs::path& map) {
+    return runFieldrig({"process", session.string(), "--map", map.string(), "--out",
+                        (dir.path() / ("results-" + map.stem().string())).string()},
+                       dir.path());
+  };
+  const fs::path other_ids =
+      writeMap("other-ids.csv", row("R1P1", "plot-1", 0) + row("R1P2", "plot-2", 0));
+  const auto none = process(other_ids);
+  EXPECT_EQ(none.exit_code, 2) << none.err;
+  EXPECT_NE(none.err.find(other_ids.string() + ": holds none of the session's locations"),
+            std::string::npos)
+      << none.err;
+  const fs::path elsewhere =
+      writeMap("elsewhere.csv", row("plot-1", "plot-1", 0.5) + row("plot-2", "plot-2", 0.5) +
+                                    row("plot-3", "plot-3", 0.5));
+  const auto far = process(elsewhere);
+  EXPECT_EQ(far.exit_code, 2) << far.err;
+  EXPECT_NE(
+      far.err.find(elsewhere.string() + ": every location of the session lies more than 10 m"),
+      std::string::npos)
+      << far.err;
+  EXPECT_TRUE(none.out_lines.empty() && far.out_lines.empty());
+  EXPECT_FALSE(fs::exists(dir.path() / "results-elsewhere" / "plots.jsonl"));
+
+  // plot-1 where it was taken, plot-2 missing, plot-3 0.001° (111 m) north.
+  const auto partly =
+      process(writeMap("partly.csv", row("plot-1", "plot-1", 0) + row("plot-3", "plot-3", 0.001)));
+  ASSERT_EQ(partly.exit_code, 0) << partly.err;
+  ASSERT_EQ(partly.out_lines.size(), 4U) << partly.err;
+  std::map<std::string, Json> lines;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const Json line = Json::parse(partly.out_lines[i]);
+    lines[line.at("plot").get<std::string>()] = line;
+  }
+  auto problems = [&](const std::string& plot) { return lines.at(plot).at("problems").dump(); };
+  EXPECT_EQ(problems("plot-1").find("map"), std::string::npos) << problems("plot-1");
+  EXPECT_NE(problems("plot-2").find("location plot-2 is not in the map: placed at the fix at the "
+                                    "trigger"),
+            std::string::npos)
+      << problems("plot-2");
+  EXPECT_NEAR(lines.at("plot-2").at("lat").get<double>(), fixes.at("plot-2").first, 1e-9);
+  EXPECT_NE(problems("plot-3").find("map location plot-3 is 111 m from the fix at the trigger"),
+            std::string::npos)
+      << problems("plot-3");
+  EXPECT_NEAR(lines.at("plot-3").at("lat").get<double>(), fixes.at("plot-3").first + 0.001, 1e-9);
+  EXPECT_EQ(Json::parse(partly.out_lines.back()).at("summary").at("placement_problems"), 2);
+}
+
 TEST(ProcessCli, BadCalibrationIsAClearError) {
   ScopedTempDir dir("process_cli_badcal");
   const fs::path session = dir.path() / "session";

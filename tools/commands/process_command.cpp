@@ -109,6 +109,8 @@ int runProcess(const ProcessArgs& args) {
     auto loaded = gps::LocationMap::load(args.map);
     if (!loaded)
       return fail(who, loaded.error().message);
+    if (auto matches = daemon::checkMapMatchesSession(reader, *loaded, args.map); !matches)
+      return fail(who, matches.error().message);
     map = std::move(*loaded);
   }
   auto processor = pipeline::PlotProcessor::create(*rig, options);
@@ -136,6 +138,7 @@ int runProcess(const ProcessArgs& args) {
   summary["ok"] = done->ok;
   summary["partial_clouds"] = done->partial_clouds;
   summary["unplaced"] = done->unplaced;
+  summary["placement_problems"] = done->placement_problems;
   summary["already_done"] = done->already_done;
   summary["torn_index_line"] = reader.tornLine() ? Json(reader.tornLine()->line) : Json(nullptr);
   summary["plots_in_results"] = (*results)->plots();

@@ -38,12 +38,21 @@ struct PlotIdentity {
   std::string time;                        // ISO 8601, GPS time of the trigger
   std::optional<std::pair<double, double>> position;  // lat, lon
   std::string trigger_status;                         // "on_time", "late"; empty for manual
+  // Why the position may not be the plot's: listed among the line's problems.
+  std::optional<std::string> placement_problem;
 };
 
-// Where a set's plot is: its map location when the map knows it, else the fix at the trigger.
-std::optional<std::pair<double, double>> plotPosition(const std::optional<std::string>& location_id,
-                                                      const std::optional<core::GpsFix>& fix,
-                                                      const gps::LocationMap* map);
+// How far a map location may lie from the fix at its trigger before the line says so. A trigger
+// fires within centimetres of its location with RTK and within a few metres without; tens of
+// metres means a map of another field, or a fix that jumped.
+inline constexpr double kMapToFixToleranceM = 10.0;
+
+// Sets identity.position: the map location of identity.location_id when the map knows it, else
+// the fix at the trigger (none without either). With a map, a location it lacks, or one farther
+// than kMapToFixToleranceM from the fix, is said in identity.placement_problem: a map of another
+// field must not place plots unseen.
+void placePlot(PlotIdentity& identity, const std::optional<core::GpsFix>& fix,
+               const gps::LocationMap* map);
 
 // The result line: set, trigger_id, plot, location, time, lat, lon, trigger_status, cloud_points,
 // partial, traits (traits::traitsToJson without slices and timings), problems.

@@ -48,7 +48,10 @@ struct SessionProcessingSummary {
   std::size_t sets = 0;  // processed by this run
   std::size_t ok = 0;    // of those, with traits status ok
   std::size_t partial_clouds = 0;
-  std::size_t unplaced = 0;      // neither a map location nor a fix
+  std::size_t unplaced = 0;  // neither a map location nor a fix
+  // Placed, but with a placement_problem on the line (results_writer.h): a location the map
+  // lacks, or a map location far from the fix at the trigger.
+  std::size_t placement_problems = 0;
   std::size_t already_done = 0;  // skipped: in the results before this run
 };
 
@@ -57,6 +60,13 @@ struct SessionProcessingSummary {
 // differs there (results of another session, e.g. the same --out given for two sessions).
 core::Result<void> checkResultsMatchSession(const recording::SessionReader& reader,
                                             const ResultsWriter& results);
+
+// A map that places none of the session's located sets where they were taken is of another field:
+// the error names `map_name` and the first set, when no located set's id is in the map, or when
+// every one that has a fix lies farther than kMapToFixToleranceM from its map location. A map that
+// misses or misplaces only some is taken, and each such line says so (placePlot).
+core::Result<void> checkMapMatchesSession(const recording::SessionReader& reader,
+                                          const gps::LocationMap& map, const std::string& map_name);
 
 // `on_line` sees each set's result line before it is added to `results`; `on_problem` hears of a
 // cloud that cannot be written, and of a set whose trigger id an earlier set of the index already

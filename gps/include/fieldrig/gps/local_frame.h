@@ -34,6 +34,9 @@ class LocalFrame {
   GeographicLib::LocalCartesian cartesian_;
 };
 
+// The WGS84 geodesic distance between two points, metres (GeographicLib).
+double geodesicDistanceMetres(const GeodeticPoint& a, const GeodeticPoint& b);
+
 // Degrees true (clockwise from north) of an east/north direction, in [0, 360).
 double bearingDegrees(double east, double north);
 
