@@ -18,13 +18,13 @@ Json optionalJson(const std::optional<std::string>& value) {
 }  // namespace
 
 ResultsFiles resultsFiles(const std::filesystem::path& dir) {
-  return {dir / "plots.jsonl", dir / "plots.csv", dir / "plots.geojson"};
+  return {dir / "plots.jsonl", dir / "plots.csv", dir / "plots.geojson", dir / "source.json"};
 }
 
 void removeResults(const std::filesystem::path& dir) {
   const ResultsFiles files = resultsFiles(dir);
   std::error_code ec;  // a file that is not there is already removed
-  for (const std::filesystem::path& file : {files.jsonl, files.csv, files.geojson})
+  for (const std::filesystem::path& file : {files.jsonl, files.csv, files.geojson, files.source})
     std::filesystem::remove(file, ec);
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "fieldrig/core/durable_file.h"
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/gps/local_frame.h"
@@ -42,6 +43,41 @@ core::Result<void> checkResultsMatchSession(const recording::SessionReader& read
                          ": results of another session (give another results folder, or --force)"};
     }
   }
+  return {};
+}
+
+core::Result<void> claimResultsFor(const recording::SessionReader& reader,
+                                   const std::filesystem::path& results_dir) {
+  const std::string& start_time = reader.metadata().start_time;
+  const std::filesystem::path source = resultsFiles(results_dir).source;
+  std::error_code ec;
+  if (std::filesystem::exists(source, ec)) {
+    std::string error;
+    const std::optional<std::string> text = core::readWholeFile(source, error);
+    if (!text)
+      return core::Error{error};
+    std::string claimed_start, claimed_session;
+    try {
+      const nlohmann::json claimed = nlohmann::json::parse(*text);
+      claimed_start = claimed.at("start_time").get<std::string>();
+      claimed_session = claimed.at("session").get<std::string>();
+    } catch (const std::exception& e) {
+      return core::Error{source.string() + ": not a results source record (" + e.what() +
+                         "); remove it, or give --force"};
+    }
+    if (claimed_start == start_time)
+      return {};
+    return core::Error{source.string() + ": the results are of the session started at " +
+                       claimed_start + " (" + claimed_session + "), but " + reader.dir().string() +
+                       " started at " + start_time +
+                       ": results of another session (give another results folder, or --force)"};
+  }
+  const nlohmann::ordered_json record = {
+      {"session", std::filesystem::absolute(reader.dir(), ec).string()},
+      {"start_time", start_time}};
+  if (std::string failed = core::replaceFileAtomically(source, record.dump(2) + "\n");
+      !failed.empty())
+    return core::Error{std::move(failed)};
   return {};
 }
 

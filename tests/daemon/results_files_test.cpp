@@ -33,12 +33,15 @@ TEST(ResultsFiles, RemoveResultsTakesTheResultsFilesOnly) {
   EXPECT_EQ(files.jsonl, dir / "plots.jsonl");
   EXPECT_EQ(files.csv, dir / "plots.csv");
   EXPECT_EQ(files.geojson, dir / "plots.geojson");
-  for (const fs::path& file : {files.jsonl, files.csv, files.geojson, dir / "plot-1_set0.ply"})
+  EXPECT_EQ(files.source, dir / "source.json");
+  for (const fs::path& file :
+       {files.jsonl, files.csv, files.geojson, files.source, dir / "plot-1_set0.ply"})
     std::ofstream(file) << "x\n";
   removeResults(dir);
   EXPECT_FALSE(fs::exists(files.jsonl));
   EXPECT_FALSE(fs::exists(files.csv));
   EXPECT_FALSE(fs::exists(files.geojson));
+  EXPECT_FALSE(fs::exists(files.source));
   EXPECT_TRUE(fs::exists(dir / "plot-1_set0.ply"));
   removeResults(dir);  // nothing left to remove is not a failure
   removeResults(tmp / "no-such-folder");

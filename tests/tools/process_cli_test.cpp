@@ -199,6 +199,44 @@ TEST(ProcessCli, ResumesSkipsWhatIsDoneRedoesWithForceAndSplitsIntoShards) {
   EXPECT_NE(bad.err.find("--shard"), std::string::npos) << bad.err;
 }
 
+// Two sessions of `sim plots` have the same plot ids and trigger times, which the trigger check
+// cannot tell apart: the results folder names the session it is of (source.json), so results of
+// the other are refused rather than every set skipped as already done.
+TEST(ProcessCli, ResultsOfAnotherSessionWithTheSameTriggersAreRefused) {
+  ScopedTempDir dir("process_cli_source");
+  const fs::path first = dir.path() / "first";
+  const fs::path second = dir.path() / "second";
+  ASSERT_TRUE(recordPlots(dir, first, 1));
+  ASSERT_TRUE(recordPlots(dir, second, 1));
+  ASSERT_EQ(readWholeFile(first / "index.jsonl"), readWholeFile(second / "index.jsonl"));
+  const fs::path out = dir.path() / "results";
+  const auto made = runFieldrig({"process", first.string(), "--out", out.string()}, dir.path());
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const Json source = Json::parse(readWholeFile(out / "source.json"));
+  EXPECT_EQ(source.at("session"), fs::absolute(first).string());
+  const std::string before = readWholeFile(out / "plots.jsonl");
+
+  const auto again = runFieldrig({"process", first.string(), "--out", out.string()}, dir.path());
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(Json::parse(again.out_lines.back()).at("summary").at("already_done"), 1);
+  const auto other = runFieldrig({"process", second.string(), "--out", out.string()}, dir.path());
+  EXPECT_EQ(other.exit_code, 2) << other.err;
+  EXPECT_NE(other.err.find((out / "source.json").string() +
+                           ": the results are of the session "
+                           "started at " +
+                           source.at("start_time").get<std::string>() + " (" +
+                           fs::absolute(first).string() + "), but " + second.string()),
+            std::string::npos)
+      << other.err;
+  EXPECT_TRUE(other.out_lines.empty());
+  EXPECT_EQ(readWholeFile(out / "plots.jsonl"), before);
+  const auto forced =
+      runFieldrig({"process", second.string(), "--out", out.string(), "--force"}, dir.path());
+  ASSERT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_EQ(Json::parse(readWholeFile(out / "source.json")).at("session"),
+            fs::absolute(second).string());
+}
+
 // A set whose index line a crash cut short is not in the session: the run says so, naming the
 // line, instead of the set vanishing from the results unremarked.
 TEST(ProcessCli, ATornLastIndexLineIsNamed) {

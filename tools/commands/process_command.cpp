@@ -125,6 +125,8 @@ int runProcess(const ProcessArgs& args) {
     return fail(who, results.error().message);
   if (auto matches = daemon::checkResultsMatchSession(reader, **results); !matches)
     return fail(who, matches.error().message);
+  if (auto claimed = daemon::claimResultsFor(reader, out_dir); !claimed)
+    return fail(who, claimed.error().message);
   if (args.clouds)
     run.clouds_dir = out_dir;
   auto done = daemon::processSession(

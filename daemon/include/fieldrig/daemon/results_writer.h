@@ -58,9 +58,10 @@ void placePlot(PlotIdentity& identity, const std::optional<core::GpsFix>& fix,
 // partial, traits (traits::traitsToJson without slices and timings), problems.
 nlohmann::ordered_json plotLine(const PlotIdentity& identity, const pipeline::PlotResult& result);
 
-// The files of a results folder.
+// The files of a results folder. `source` (source.json) names the session the results are of,
+// once `fieldrig process` has written into the folder (session_processing.h: claimResultsFor).
 struct ResultsFiles {
-  std::filesystem::path jsonl, csv, geojson;
+  std::filesystem::path jsonl, csv, geojson, source;
 };
 ResultsFiles resultsFiles(const std::filesystem::path& dir);
 

@@ -61,6 +61,15 @@ struct SessionProcessingSummary {
 core::Result<void> checkResultsMatchSession(const recording::SessionReader& reader,
                                             const ResultsWriter& results);
 
+// The trigger check above cannot tell apart two sessions whose sets have the same locations and
+// trigger times (two synthetic fields of one layout). So the results folder records the session it
+// is of, by the start time in its session.json (which stays when a session is reopened or moved):
+// the first run writes DIR/source.json, and a later one of a session started at another time is
+// refused, naming both (removeResults, i.e. --force, clears it). A folder without the file (the
+// daemon's live results) is claimed by the first run that writes into it after the trigger check.
+core::Result<void> claimResultsFor(const recording::SessionReader& reader,
+                                   const std::filesystem::path& results_dir);
+
 // A map that places none of the session's located sets where they were taken is of another field:
 // the error names `map_name` and the first set, when no located set's id is in the map, or when
 // every one that has a fix lies farther than kMapToFixToleranceM from its map location. A map that
