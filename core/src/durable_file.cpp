@@ -68,36 +68,74 @@ std::optional<std::string> readWholeFile(const std::filesystem::path& path, std:
 }
 
 std::string replaceFileAtomically(const std::filesystem::path& path, std::string_view text) {
-  const std::filesystem::path temp = path.string() + ".tmp";
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  return replaceFilesTogether({{path, text}});
+}
+
+namespace {
+
+std::filesystem::path tempPathOf(const std::filesystem::path& path) {
+  return path.string() + ".tmp";
+}
+
+// Writes `data` to `path` (created or truncated), with an fsync when `sync`; 0 or the errno.
+int writeAndClose(const std::filesystem::path& path, std::string_view data, bool sync,
+                  bool& created) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  created = fd >= 0;
   if (fd < 0)
-    return temp.string() + ": cannot create: " + std::strerror(errno);
-  int error = writeFully(fd, text.data(), text.size());
-  if (error == 0 && ::fsync(fd) != 0)
+    return errno;
+  int error = writeFully(fd, data.data(), data.size());
+  if (error == 0 && sync && ::fsync(fd) != 0)
     error = errno;
-  ::close(fd);
-  if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0)
+  // close() reports what a network or full file system deferred.
+  if (::close(fd) != 0 && error == 0)
     error = errno;
-  if (error != 0) {
-    ::unlink(temp.c_str());
-    return path.string() + ": cannot write: " + std::strerror(error);
+  return error;
+}
+
+}  // namespace
+
+std::string replaceFilesTogether(std::initializer_list<FileContent> files) {
+  std::string failed;
+  for (const FileContent& file : files) {
+    bool created = false;
+    if (const int error = writeAndClose(tempPathOf(file.path), file.text, true, created);
+        error != 0) {
+      failed = created
+                   ? file.path.string() + ": cannot write: " + std::strerror(error)
+                   : tempPathOf(file.path).string() + ": cannot create: " + std::strerror(error);
+      break;
+    }
   }
-  if (const int sync_error = syncDirectory(path.parent_path()); sync_error != 0)
-    return path.parent_path().string() + ": cannot sync: " + std::strerror(sync_error);
+  for (const FileContent& file : files) {
+    if (failed.empty() && ::rename(tempPathOf(file.path).c_str(), file.path.c_str()) != 0)
+      failed = file.path.string() + ": cannot write: " + std::strerror(errno);
+    if (!failed.empty())
+      ::unlink(tempPathOf(file.path).c_str());
+  }
+  if (!failed.empty())
+    return failed;
+  for (const FileContent& file : files) {
+    if (const int sync_error = syncDirectory(file.path.parent_path()); sync_error != 0)
+      return file.path.parent_path().string() + ": cannot sync: " + std::strerror(sync_error);
+  }
   return {};
 }
 
 std::string writeWholeFile(const std::filesystem::path& path, std::string_view data) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0)
-    return path.string() + ": cannot create: " + std::strerror(errno);
-  int error = writeFully(fd, data.data(), data.size());
-  // close() reports what a network or full file system deferred.
-  if (::close(fd) != 0 && error == 0)
-    error = errno;
-  if (error != 0)
-    return path.string() + ": cannot write: " + std::strerror(error);
-  return {};
+  struct stat info {};
+  const bool in_place = ::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode);
+  const std::filesystem::path target = in_place ? path : tempPathOf(path);
+  bool created = false;
+  const int error = writeAndClose(target, data, false, created);
+  if (!created)
+    return path.string() + ": cannot create: " + std::strerror(error);
+  if (error == 0 && (in_place || ::rename(target.c_str(), path.c_str()) == 0))
+    return {};
+  const int failure = error != 0 ? error : errno;
+  if (!in_place)
+    ::unlink(target.c_str());
+  return path.string() + ": cannot write: " + std::strerror(failure);
 }
 
 std::string appendDurably(const std::filesystem::path& path, std::string_view text) {

@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "support/file_size_limit.h"
 #include "support/temp_dir.h"
 
 namespace fieldrig::core {
@@ -120,6 +121,53 @@ TEST(DurableFileTest, WriteWholeFileReplacesTheContentAndReportsAFullDisk) {
   EXPECT_NE(full.find(std::strerror(ENOSPC)), std::string::npos) << full;
   const fs::path missing = dir / "no" / "such" / "file.bin";
   EXPECT_EQ(writeWholeFile(missing, "x").rfind(missing.string() + ": cannot create", 0), 0u);
+}
+
+// A write that fails part-way (here a file size limit, as a full disk would) leaves the old
+// file whole and no partial one beside it.
+TEST(DurableFileTest, AWholeFileWriteThatFailsKeepsTheOldFile) {
+  const ScopedTempDir dir("durable_whole_fails");
+  const fs::path path = dir / "cloud.ply";
+  ASSERT_EQ(writeWholeFile(path, "the old content"), "");
+  std::string failed;
+  {
+    const testing_support::FileSizeLimit limit(64);
+    failed = writeWholeFile(path, std::string(4096, 'x'));
+  }
+  EXPECT_EQ(failed.rfind(path.string() + ": cannot write: ", 0), 0u) << failed;
+  EXPECT_NE(failed.find(std::strerror(EFBIG)), std::string::npos) << failed;
+  EXPECT_EQ(read(path), "the old content");
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  {
+    const testing_support::FileSizeLimit limit(64);
+    EXPECT_NE(writeWholeFile(dir / "new.ply", std::string(4096, 'x')), "");
+  }
+  EXPECT_FALSE(fs::exists(dir / "new.ply"));
+  EXPECT_FALSE(fs::exists(dir / "new.ply.tmp"));
+}
+
+// Files that belong together: when one cannot be written, none is replaced.
+TEST(DurableFileTest, FilesReplacedTogetherStayOldWhenOneCannotBeWritten) {
+  const ScopedTempDir dir("durable_together");
+  const fs::path small = dir / "intrinsics.yml";
+  const fs::path large = dir / "extrinsics.yml";
+  ASSERT_EQ(replaceFilesTogether({{small, "old small"}, {large, "old large"}}), "");
+  EXPECT_EQ(read(small), "old small");
+  EXPECT_EQ(read(large), "old large");
+  const std::string large_text(4096, 'n');
+  std::string failed;
+  {
+    const testing_support::FileSizeLimit limit(64);  // the small one fits, the large one not
+    failed = replaceFilesTogether({{small, "new small"}, {large, large_text}});
+  }
+  EXPECT_EQ(failed.rfind(large.string() + ": cannot write: ", 0), 0u) << failed;
+  EXPECT_EQ(read(small), "old small");
+  EXPECT_EQ(read(large), "old large");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 2)
+      << "no temporary file is left";
+  ASSERT_EQ(replaceFilesTogether({{small, "new small"}, {large, large_text}}), "");
+  EXPECT_EQ(read(small), "new small");
+  EXPECT_EQ(read(large), large_text);
 }
 
 TEST(DurableFileTest, AnAppenderKilledMidWriteLeavesEveryEarlierRecordWhole) {

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -24,8 +25,19 @@ std::optional<std::string> readWholeFile(const std::filesystem::path& path, std:
 // old or the new content, never a mix. Empty on success, else "PATH: reason".
 std::string replaceFileAtomically(const std::filesystem::path& path, std::string_view text);
 
-// Writes `data` to `path` (created or truncated) and checks that every byte and the close went
-// through; no fsync: for outputs that are remade by running again (rendered images, maps).
+// Files that belong together (a calibration's two): every temporary file is written and synced
+// before the first rename, so a write that fails (a full disk) leaves all the old files as they
+// were. Only a crash between the renames can leave some new and some old.
+struct FileContent {
+  std::filesystem::path path;
+  std::string_view text;
+};
+std::string replaceFilesTogether(std::initializer_list<FileContent> files);
+
+// Writes `data` to `path` and checks that every byte and the close went through; no fsync: for
+// outputs that are remade by running again (rendered images, maps, clouds). A regular file (or a
+// new one) is written beside as PATH.tmp and renamed over it, so a failed write leaves the old
+// file whole and no partial one; anything else (/dev/stdout, a pipe) is written in place.
 // Empty on success, else "PATH: reason".
 std::string writeWholeFile(const std::filesystem::path& path, std::string_view data);
 
