@@ -456,14 +456,15 @@ core::Result<std::filesystem::path> saveStereoCalibration(const StereoCalibratio
   } catch (const cv::Exception& e) {
     return Error{directory.string() + ": writing the calibration failed: " + e.what()};
   }
-  // Each file is replaced whole, so that a crash leaves the old file or the new one.
-  for (const auto& [name, text] : {std::pair{"intrinsics.yml", &intrinsics_text},
-                                   std::pair{"extrinsics.yml", &extrinsics_text}}) {
-    if (std::string failed =
-            core::replaceFileAtomically(std::filesystem::absolute(directory / name), *text);
-        !failed.empty())
-      return Error{std::move(failed)};
-  }
+  // The two files are one calibration: both are written before either replaces the old one, so
+  // a write that fails (a full disk) leaves the old pair, never a new intrinsics.yml beside the
+  // old extrinsics.yml.
+  const std::filesystem::path absolute = std::filesystem::absolute(directory);
+  if (std::string failed =
+          core::replaceFilesTogether({{absolute / "intrinsics.yml", intrinsics_text},
+                                      {absolute / "extrinsics.yml", extrinsics_text}});
+      !failed.empty())
+    return Error{std::move(failed)};
   return directory;
 }
 
