@@ -1,12 +1,15 @@
 #include "fieldrig/cloud/fusion.h"
-#include "fieldrig/core/time.h"
 
-#include <pcl/io/ply_io.h>
-
+#include <bit>
 #include <chrono>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "fieldrig/core/durable_file.h"
+#include "fieldrig/core/time.h"
 
 namespace fieldrig::cloud {
 namespace {
@@ -239,12 +242,30 @@ core::Result<std::filesystem::path> writePly(const Cloud& cloud,
   if (cloud.empty()) {
     return core::Error{file.string() + ": the cloud is empty; nothing to write"};
   }
-  // Without PCL's extra "camera" element (use_camera = false): a plain vertex list with
-  // red/green/blue that every PLY reader takes.
-  pcl::PLYWriter writer;
-  if (writer.write(file.string(), cloud, /*binary=*/true, /*use_camera=*/false) != 0) {
-    return core::Error{file.string() + ": cannot write PLY"};
+  // Written here, not by pcl::PLYWriter: PCL's writer truncates the file in place and reports
+  // success after a short write (a full disk), which left a cut cloud where the old one was. The
+  // format is PCL's own for this point type without its "camera" element: a plain vertex list
+  // with red/green/blue that every PLY reader takes.
+  static_assert(std::endian::native == std::endian::little, "binary_little_endian is written");
+  std::string bytes =
+      "ply\nformat binary_little_endian 1.0\ncomment fieldrig fused cloud, plot "
+      "frame, metres\nelement vertex " +
+      std::to_string(cloud.size()) +
+      "\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "end_header\n";
+  constexpr std::size_t kVertexBytes = 3 * sizeof(float) + 3;
+  std::size_t at = bytes.size();
+  bytes.resize(at + cloud.size() * kVertexBytes);
+  for (const pcl::PointXYZRGB& point : cloud) {
+    const float xyz[3] = {point.x, point.y, point.z};
+    const std::uint8_t rgb[3] = {point.r, point.g, point.b};
+    std::memcpy(&bytes[at], xyz, sizeof xyz);
+    std::memcpy(&bytes[at + sizeof xyz], rgb, sizeof rgb);
+    at += kVertexBytes;
   }
+  if (std::string failed = core::writeWholeFile(file, bytes); !failed.empty())
+    return core::Error{std::move(failed)};
   return file;
 }
 

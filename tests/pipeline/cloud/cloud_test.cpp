@@ -13,6 +13,7 @@
 
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/cloud/rig_calibration.h"
+#include "support/file_size_limit.h"
 #include "support/plane_rig_scene.h"
 #include "support/temp_dir.h"
 
@@ -414,6 +415,28 @@ TEST(Ply, WritesBinaryWithColourAndRefusesEmpty) {
   EXPECT_EQ(back[0].r, 200);
   EXPECT_EQ(back[0].b, 30);
   EXPECT_FALSE(writePly(Cloud(), dir / "empty.ply"));
+
+  // A write that fails (a full disk; here a file size limit) is an error and leaves the old
+  // cloud whole: PCL's writer reported success and left a cut file in its place.
+  const auto bytesOf = [](const std::filesystem::path& file) {
+    std::ifstream whole(file, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(whole)), std::istreambuf_iterator<char>());
+  };
+  const std::string before = bytesOf(dir / "one.ply");
+  Cloud large;
+  large.resize(10000, p);
+  core::Result<std::filesystem::path> failed = dir / "one.ply";
+  {
+    const FileSizeLimit limit(4096);
+    failed = writePly(large, dir / "one.ply");
+  }
+  ASSERT_FALSE(failed);
+  EXPECT_NE(failed.error().message.find("one.ply: cannot write: File too large"), std::string::npos)
+      << failed.error().message;
+  EXPECT_EQ(bytesOf(dir / "one.ply"), before);
+  ASSERT_TRUE(writePly(large, dir / "one.ply"));
+  ASSERT_EQ(pcl::io::loadPLYFile((dir / "one.ply").string(), back), 0);
+  EXPECT_EQ(back.size(), 10000u);
 }
 
 }  // namespace
