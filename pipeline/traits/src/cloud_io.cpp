@@ -395,6 +395,12 @@ core::Result<Points> readPlyBinaryBody(const std::string& path, const PlyHeader&
         points.push_back(point);
     }
   }
+  if (h.vertex + 1 == h.elements.size() && at != end) {
+    return Error{path + ": " + std::to_string(end - at) + " bytes after the " +
+                 std::to_string(h.elements[h.vertex].count) +
+                 " 'vertex' elements the header declares (the last element): the header's count "
+                 "is wrong or the file is damaged"};
+  }
   return points;
 }
 
@@ -467,6 +473,20 @@ core::Result<Points> readPlyAsciiBody(const std::string& path, const PlyHeader& 
       if (vertex)
         points.push_back(point);
       ++i;
+    }
+  }
+  // Whitespace may end the file; a value past the declared elements means a wrong count.
+  if (h.vertex + 1 == h.elements.size()) {
+    while (at != end && std::isspace(static_cast<unsigned char>(*at))) {
+      if (*at == '\n')
+        ++line;
+      ++at;
+    }
+    if (at != end) {
+      return Error{path + ":" + std::to_string(line + 1) + ": a value after the " +
+                   std::to_string(h.elements[h.vertex].count) +
+                   " 'vertex' elements the header declares (the last element): the header's "
+                   "count is wrong or the file is damaged"};
     }
   }
   return points;

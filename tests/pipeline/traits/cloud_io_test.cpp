@@ -116,6 +116,22 @@ TEST(CloudIo, PlyWithinTheFileLoads) {
   EXPECT_EQ(ascii->size(), 2u);
 }
 
+// A header that declares fewer points than the file holds read the first ones only, and
+// `fieldrig traits` gave the traits of part of the plot with exit 0.
+TEST(CloudIo, PlyWithMoreDataThanItsHeaderDeclaresIsRefused) {
+  ScopedTempDir dir("cloud_io_ply_more");
+  expectRefused(
+      writeFile(dir, "more.ply", withCount(kPlyBinaryHead, "1") + binary({1, 2, 3, 4, 5, 6})),
+      "12 bytes after the 1 'vertex' elements the header declares");
+  expectRefused(
+      writeFile(dir, "more_ascii.ply", withCount(kPlyAsciiHead, "1") + "1 2 3\n\n4 5 6\n"),
+      "more_ascii.ply:10: a value after the 1 'vertex' elements the header declares");
+  auto spaces =
+      loadCloud(writeFile(dir, "spaces.ply", withCount(kPlyAsciiHead, "1") + "1 2 3\n \n\t\n"));
+  ASSERT_TRUE(spaces) << spaces.error().message;
+  EXPECT_EQ(spaces->size(), 1u);
+}
+
 // PCL's reader read a word as NaN and `fieldrig traits` went on with exit 0.
 TEST(CloudIo, PlyAsciiWordsAreRefusedNamingTheLine) {
   ScopedTempDir dir("cloud_io_ply_word");
