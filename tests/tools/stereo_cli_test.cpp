@@ -16,9 +16,11 @@
 namespace fieldrig::stereo {
 namespace {
 
+using testing_support::readWholeFile;
 using testing_support::runFieldrig;
 using testing_support::ScopedTempDir;
 using Json = nlohmann::json;
+namespace fs = std::filesystem;
 
 const std::string kData = std::string(FIELDRIG_SHARED_DATA_DIR) + "/stereo/";
 
@@ -126,6 +128,20 @@ TEST(StereoCli, BadInputIsAClearError) {
       mismatched.err.find("calibration is for 640x480 images but " + teddy_left + " is 450x375"),
       std::string::npos)
       << mismatched.err;
+
+  // --out naming an input would overwrite that image with the PFM.
+  const fs::path own_left = dir / "left.png";
+  fs::copy_file(teddy_left, own_left);
+  const std::string left_before = readWholeFile(own_left);
+  auto onto_input =
+      runFieldrig({"disparity", "--left", own_left.string(), "--right",
+                   kData + "middlebury2003/teddy/im6.png", "--out", own_left.string()},
+                  dir.path());
+  EXPECT_EQ(onto_input.exit_code, 2);
+  EXPECT_NE(onto_input.err.find("--out " + own_left.string() + " is the input image"),
+            std::string::npos)
+      << onto_input.err;
+  EXPECT_EQ(readWholeFile(own_left), left_before);
 
   auto missing = runFieldrig({"disparity", "--left", (dir / "absent.png").string(), "--right",
                               calib_right, "--out", (dir / "x.pfm").string()},

@@ -1,6 +1,7 @@
 // `fieldrig disparity --left L --right R [--intrinsics I --extrinsics E] --out FILE.pfm`: the
 // disparity of one image pair (rectified first when a calibration is given) as PFM. Prints one
 // JSON line on success; bad input exits 2 with a message naming the file.
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -30,6 +31,13 @@ int runDisparity(const DisparityArgs& args) {
   if (left.empty()) {
     std::cerr << who << args.left << ": cannot read the image\n";
     return kExitBadInput;
+  }
+  // The PFM replaces --out whole: given an input's path it would overwrite that image.
+  for (const std::string& input : {args.left, args.right}) {
+    std::error_code ec;
+    if (std::filesystem::equivalent(args.out, input, ec))
+      return fail(who,
+                  "--out " + args.out + " is the input image " + input + ": give another file");
   }
   const cv::Mat right = cv::imread(args.right, cv::IMREAD_COLOR);
   if (right.empty()) {
