@@ -179,6 +179,11 @@ class Daemon {
                       config_.replay.nmea.string());
         return kExitBadInput;
       }
+      if (fs::is_directory(config_.replay.nmea, ec)) {
+        spdlog::error("{}: replay.nmea: {}: a folder, not an NMEA file or device", sourceName(),
+                      config_.replay.nmea.string());
+        return kExitBadInput;
+      }
     }
     if (config_.recording.dir.empty()) {
       spdlog::error("{}: recording.dir: no session folder configured", sourceName());

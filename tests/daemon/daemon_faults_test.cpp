@@ -104,6 +104,19 @@ TEST_F(DaemonFaults, AMissingCalibrationIsNamedAndNothingIsWritten) {
   EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a bad calibration wrote something";
 }
 
+// A folder as the NMEA input read as no fixes at all: an empty session and exit 0.
+TEST_F(DaemonFaults, AnNmeaFolderIsNamedAndNothingIsWritten) {
+  ScopedTempDir dir("daemon_nmea_folder");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  const auto run =
+      runDaemon({"replay", "--config", config.string(), "--nmea", field_.string()}, dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("replay.nmea: " + field_.string() + ": a folder, not an NMEA file"),
+            std::string::npos)
+      << run.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a folder as NMEA wrote something";
+}
+
 TEST_F(DaemonFaults, AnUnknownCameraDriverIsNamedWithTheDriversItHasSimIncluded) {
   ScopedTempDir dir("daemon_bad_driver");
   const fs::path config = writeReplayConfig(dir.path(), "run", field_);
