@@ -12,6 +12,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -113,9 +114,30 @@ std::size_t BatchPlan::taskSets(std::size_t task) const {
   return total;
 }
 
+namespace {
+
+// An sbatch option becomes one "#SBATCH" line of the job script: a line break in it would start
+// a shell line of its own there, run by every task.
+std::optional<std::string> sbatchOptionProblem(const std::vector<std::string>& options) {
+  for (const std::string& option : options) {
+    for (const char c : option) {
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+        return "--sbatch-option '" + option +
+               "': a control character (a line break would start a line of its own in the job "
+               "script)";
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 core::Result<BatchPlan> makeBatchPlan(const BatchPlanRequest& request) {
   if (request.sessions.empty())
     return core::Error{"no sessions given"};
+  if (auto problem = sbatchOptionProblem(request.sbatch_options))
+    return core::Error{std::move(*problem)};
   if (request.shards == 0)
     return core::Error{"--shards must be at least 1"};
   BatchPlan plan;
@@ -256,6 +278,8 @@ core::Result<BatchPlan> batchPlanFromJson(const nlohmann::ordered_json& json,
       plan.calibration.push_back(
           {file.at("path").get<std::string>(), file.at("sha256").get<std::string>()});
     plan.sbatch_options = json.at("sbatch_options").get<std::vector<std::string>>();
+    if (auto problem = sbatchOptionProblem(plan.sbatch_options))
+      return core::Error{source + ": " + *problem};
     for (const Json& in : json.at("sessions")) {
       BatchSession session;
       session.path = in.at("path").get<std::string>();

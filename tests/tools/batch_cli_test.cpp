@@ -163,6 +163,17 @@ TEST_F(BatchCli, MissingSessionsAndAbsentPlotsAreNamed) {
   EXPECT_EQ(refused.exit_code, 2);
   EXPECT_NE(refused.err.find(missing.string()), std::string::npos) << refused.err;
 
+  // An sbatch option becomes a line of the job script: a line break would add a shell line.
+  const auto injected =
+      runFieldrig({"batch", "plan", (root() / "day-a").string(), "--out",
+                   (dir.path() / "injected").string(), "--sbatch-option", "--time=1\nrm -rf /"},
+                  dir.path());
+  EXPECT_EQ(injected.exit_code, 2);
+  EXPECT_NE(injected.err.find("--sbatch-option '--time=1\nrm -rf /': a control character"),
+            std::string::npos)
+      << injected.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "injected" / "job.sbatch"));
+
   // A copy of day-b, to take away after the plan.
   const fs::path day_b = dir.path() / "day-b";
   fs::copy(root() / "day-b", day_b, fs::copy_options::recursive);
@@ -172,6 +183,14 @@ TEST_F(BatchCli, MissingSessionsAndAbsentPlotsAreNamed) {
                         dir.path())
                 .exit_code,
             0);
+  for (const std::string task : {"2", "-1"}) {
+    const auto outside = runFieldrig({"batch", "task", job.string(), task}, dir.path());
+    EXPECT_EQ(outside.exit_code, 2) << task << ": " << outside.err;
+    EXPECT_TRUE(outside.out_lines.empty()) << task;
+  }
+  const auto two_tasks = runFieldrig({"batch", "task", job.string(), "2"}, dir.path());
+  EXPECT_NE(two_tasks.err.find("task 2: the plan has 2 tasks (0 to 1)"), std::string::npos)
+      << two_tasks.err;
   const auto run = runFieldrig({"batch", "run", job.string(), "--jobs", "2"}, dir.path());
   ASSERT_EQ(run.exit_code, 0) << run.err;
 

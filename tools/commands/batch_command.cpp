@@ -422,6 +422,11 @@ int runTask(const BatchArgs& args) {
   auto plan = readPlanOrSay(args.job_dir);
   if (!plan)
     return fail(who, plan.error().message);
+  if (args.task >= plan->tasks.size()) {
+    return fail(who, "task " + std::to_string(args.task) + ": the plan has " +
+                         std::to_string(plan->tasks.size()) + " tasks (0 to " +
+                         std::to_string(plan->tasks.size() - 1) + ")");
+  }
   const fs::path job_dir = fs::absolute(args.job_dir).lexically_normal();
   auto done = daemon::runBatchTask(*plan, job_dir, args.task,
                                    [](const Json& line) { std::cout << line.dump() << std::endl; });
@@ -491,7 +496,9 @@ void registerBatchCommand(CLI::App& app, int& exit_code) {
   const auto [task, task_args] = addSubcommand(
       *batch, "task", "Run one task of the plan (what each array task runs)", exit_code, runTask);
   addJobDir(task, *task_args);
-  task->add_option("task", task_args->task, "Task index, 0 <= K < shards")->required();
+  task->add_option("task", task_args->task, "Task index, 0 <= K < shards")
+      ->required()
+      ->check(CLI::NonNegativeNumber);
 }
 
 }  // namespace fieldrig::tools
