@@ -202,6 +202,11 @@ class Daemon {
         spdlog::error("{}", rig.error().message);
         return kExitBadInput;
       }
+      if (auto cameras = checkCalibratedHeadsHaveCameras(*rig, config_.cameras.layout); !cameras) {
+        spdlog::error("{}: {} (calibration {})", sourceName(), cameras.error().message,
+                      config_.calibration.string());
+        return kExitBadInput;
+      }
       pipeline::ProcessorOptions processor_options;
       processor_options.cloud = config_.pipeline.cloud;
       processor_options.traits = config_.pipeline.traits;

@@ -15,6 +15,7 @@
 #include "fieldrig/core/exception_message.h"
 #include "fieldrig/core/logging.h"
 #include "fieldrig/daemon/daemon.h"
+#include "fieldrig/daemon/head_frames.h"
 #include "fieldrig/gps/location_map.h"
 
 namespace {
@@ -38,8 +39,16 @@ int checkConfig(const std::string& path) {
     }
   }
   if (config.pipeline.enabled && !config.calibration.empty()) {
-    if (auto rig = fieldrig::cloud::loadRigCalibration(config.calibration); !rig) {
+    auto rig = fieldrig::cloud::loadRigCalibration(config.calibration);
+    if (!rig) {
       std::cerr << "fieldrigd: " << rig.error().message << '\n';
+      return kExitBadInput;
+    }
+    if (auto cameras =
+            fieldrig::daemon::checkCalibratedHeadsHaveCameras(*rig, config.cameras.layout);
+        !cameras) {
+      std::cerr << "fieldrigd: " << path << ": " << cameras.error().message << " (calibration "
+                << config.calibration.string() << ")\n";
       return kExitBadInput;
     }
   }

@@ -187,6 +187,27 @@ core::Result<std::vector<cloud::HeadFrames>> headFramesFromImageFiles(
   return frames;
 }
 
+core::Result<void> checkCalibratedHeadsHaveCameras(const cloud::RigCalibration& rig,
+                                                   const core::RigLayout& layout) {
+  const auto listed = [](const auto& names) {
+    std::string out;
+    for (const std::string& name : names)
+      out += (out.empty() ? "" : ", ") + name;
+    return out;
+  };
+  std::vector<std::string> calibrated;
+  for (const cloud::HeadCalibration& head : rig.heads)
+    calibrated.push_back(head.name);
+  for (const std::string& head : calibrated) {
+    if (std::find(layout.heads.begin(), layout.heads.end(), head) == layout.heads.end()) {
+      return core::Error{"cameras.heads (" + listed(layout.heads) + ") has no head '" + head +
+                         "', which the calibration has (" + listed(calibrated) +
+                         "): every plot would go without it"};
+    }
+  }
+  return {};
+}
+
 std::vector<cloud::HeadFrames> headFramesFromFrameSet(const core::FrameSet& set,
                                                       const std::vector<std::string>& camera_names,
                                                       const cloud::RigCalibration& rig,

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
+#include <vector>
 
 #include "fieldrig/recording/session_reader.h"
 #include "support/cli_process.h"
@@ -115,6 +116,28 @@ TEST_F(DaemonFaults, AnNmeaFolderIsNamedAndNothingIsWritten) {
             std::string::npos)
       << run.err;
   EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a folder as NMEA wrote something";
+}
+
+// Cameras for a head the calibration does not have, and none for one it has: every plot went
+// without that head, with exit 0 and an --check-config that said ok.
+TEST_F(DaemonFaults, ACalibratedHeadWithoutCamerasIsNamedAndNothingIsWritten) {
+  ScopedTempDir dir("daemon_heads");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  std::string text = readWholeFile(config);
+  text = std::regex_replace(text, std::regex("driver: sim\n"),
+                            "driver: sim\n  heads: [bottom, middle, roof]\n");
+  std::ofstream(config) << text;
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"replay", "--config", config.string()},
+        std::vector<std::string>{"--check-config", config.string()}}) {
+    const auto run = runDaemon(args, dir.path());
+    EXPECT_EQ(run.exit_code, 2) << args.front();
+    EXPECT_NE(run.err.find("cameras.heads (bottom, middle, roof) has no head 'top', which the "
+                           "calibration has (bottom, middle, top)"),
+              std::string::npos)
+        << run.err;
+  }
+  EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a rig without the calibrated heads wrote";
 }
 
 TEST_F(DaemonFaults, AnUnknownCameraDriverIsNamedWithTheDriversItHasSimIncluded) {

@@ -14,6 +14,7 @@
 #include "fieldrig/cloud/fusion.h"
 #include "fieldrig/core/frame.h"
 #include "fieldrig/core/result.h"
+#include "fieldrig/core/rig_layout.h"
 #include "fieldrig/recording/session_reader.h"
 
 namespace fieldrig::daemon {
@@ -45,6 +46,12 @@ core::Result<void> addTruthMaps(const recording::SessionReader& reader, std::uin
 // processing starts; the error names the first missing file and says where they come from.
 core::Result<void> checkTruthMaps(const recording::SessionReader& reader,
                                   const cloud::RigCalibration& rig, TruthMaps maps);
+
+// The live path's cameras against the calibration: a calibrated head that `layout` (the
+// configuration's cameras.heads) has no cameras for would be left out of every plot. The error
+// names the head and both lists.
+core::Result<void> checkCalibratedHeadsHaveCameras(const cloud::RigCalibration& rig,
+                                                   const core::RigLayout& layout);
 
 // The frames of a live set whose camera c is named camera_names[c]. The images point into the
 // set's pool buffers (no copy): keep the set alive while they are used.
