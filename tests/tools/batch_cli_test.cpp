@@ -8,7 +8,9 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -152,6 +154,23 @@ TEST_F(BatchCli, LocalRunMergesToTheSerialResultAndIsIdempotent) {
   ASSERT_EQ(runFieldrig({"batch", "merge", job.string()}, dir.path()).exit_code, 0);
   EXPECT_EQ(readWholeFile(job / "merged" / "season.jsonl"), jsonl);
   EXPECT_EQ(readWholeFile(job / "merged" / "season.csv"), csv);
+
+  // A word where a trait's number belongs is refused, naming the plot and the field; the merged
+  // files stay as they were.
+  fs::path task_lines;
+  for (const auto& entry : fs::recursive_directory_iterator(job / "tasks")) {
+    if (entry.path().filename() == "plots.jsonl" && fs::file_size(entry.path()) > 0)
+      task_lines = entry.path();
+  }
+  ASSERT_FALSE(task_lines.empty());
+  const std::string original = readWholeFile(task_lines);
+  std::ofstream(task_lines) << std::regex_replace(original, std::regex("\"height_m\":[^,]*"),
+                                                  "\"height_m\":\"tall\"");
+  const auto worded = runFieldrig({"batch", "merge", job.string()}, dir.path());
+  EXPECT_EQ(worded.exit_code, 3);
+  EXPECT_NE(worded.err.find("traits.height_m: \"tall\" is not a number"), std::string::npos)
+      << worded.err;
+  EXPECT_EQ(readWholeFile(job / "merged" / "season.jsonl"), jsonl);
 }
 
 TEST_F(BatchCli, MissingSessionsAndAbsentPlotsAreNamed) {
