@@ -268,6 +268,11 @@ core::Result<BatchPlan> batchPlanFromJson(const nlohmann::ordered_json& json,
   try {
     if (json.at("format").get<std::string>() != "fieldrig-batch-plan")
       return core::Error{source + ": not a fieldrig batch plan"};
+    // A plan of a later format may mean fields this version would read wrongly or not at all.
+    if (const Json& version = json.at("format_version"); version != 1) {
+      return core::Error{source + ": format_version " + version.dump() +
+                         ", but this fieldrig reads plans of format 1"};
+    }
     plan.software_version = json.at("software_version").get<std::string>();
     plan.fieldrig_binary = json.at("fieldrig_binary").get<std::string>();
     plan.parameter_hash = json.at("parameter_hash").get<std::string>();

@@ -55,6 +55,20 @@ TEST(BatchPlanFile, RoundTripsAndRefusesAPieceOutsideItsSession) {
   auto refused = batchPlanFromJson(json, "job/plan.json");
   ASSERT_FALSE(refused);
   EXPECT_NE(refused.error().message.find("job/plan.json"), std::string::npos);
+
+  // A plan of a later format, and one whose sbatch option would add a line to the job script.
+  json = batchPlanToJson(plan);
+  json["format_version"] = 99;
+  refused = batchPlanFromJson(json, "job/plan.json");
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().message,
+            "job/plan.json: format_version 99, but this fieldrig reads plans of format 1");
+  json = batchPlanToJson(plan);
+  json["sbatch_options"] = {"--time=1\nrm -rf /"};
+  refused = batchPlanFromJson(json, "job/plan.json");
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("job/plan.json: --sbatch-option"), std::string::npos)
+      << refused.error().message;
 }
 
 }  // namespace
