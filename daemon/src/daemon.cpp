@@ -67,6 +67,24 @@ struct RowCounts {
   std::uint64_t locations = 0, fired = 0, late = 0, missed = 0;
 };
 
+// Folders a start created, deepest first: those still empty are removed when it ends before the
+// session was opened.
+struct FoldersIfStartFails {
+  std::vector<fs::path> folders;
+  bool started = false;
+  FoldersIfStartFails() = default;
+  FoldersIfStartFails(const FoldersIfStartFails&) = delete;
+  FoldersIfStartFails& operator=(const FoldersIfStartFails&) = delete;
+  ~FoldersIfStartFails() {
+    if (started)
+      return;
+    for (const fs::path& folder : folders) {
+      std::error_code not_empty;  // a folder that holds something stays
+      fs::remove(folder, not_empty);
+    }
+  }
+};
+
 // Resident memory now and at its peak, MB (Linux: /proc/self/statm and getrusage).
 std::pair<double, double> memoryMb() {
   double rss = 0;
@@ -260,6 +278,13 @@ class Daemon {
     results_options.csv = config_.outputs.csv;
     results_options.geojson = config_.outputs.geojson;
     results_options.jsonl = config_.outputs.jsonl;
+    // The folders opening the results creates (recording.dir/results, and recording.dir itself
+    // on a first start) are removed again, when still empty, if the start fails below: a failed
+    // start leaves nothing written.
+    FoldersIfStartFails new_folders;
+    for (fs::path folder = fs::absolute(results_dir).lexically_normal();
+         folder.has_relative_path() && !fs::exists(folder); folder = folder.parent_path())
+      new_folders.folders.push_back(folder);
     if (processor_) {
       auto results = ResultsWriter::open(results_dir, results_options);
       if (!results) {
@@ -297,6 +322,7 @@ class Daemon {
     }
     acquisition_ = std::move(*created);
     acquisition_ready_ = true;
+    new_folders.started = true;
     Acquisition::ProcessSet process;
     if (processor_)
       process = [this](const core::FrameSet& set) { processSet(set); };

@@ -153,6 +153,8 @@ TEST_F(DaemonFaults, AnUnknownCameraDriverIsNamedWithTheDriversItHasSimIncluded)
   const auto listed = run.err.find("this build has: ");
   ASSERT_NE(listed, std::string::npos) << run.err;
   EXPECT_NE(run.err.find("sim", listed), std::string::npos) << run.err;
+  // The results folder, opened before the cameras, is not left behind.
+  EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a failed start left its folders";
 }
 
 TEST_F(DaemonFaults, ACameraDroppingFramesGivesFlaggedIncompleteSetsAndTheRunGoesOn) {
