@@ -135,6 +135,18 @@ TEST(TraitsCli, EmptyCloudIsAResultWithAStatus) {
   EXPECT_TRUE(out.at("height_m").is_null());
 }
 
+// A truth that cannot be written leaves no cloud behind without it.
+TEST(TraitsCli, SynthWithAnUnwritableTruthWritesNoCloud) {
+  ScopedTempDir dir("traits_cli_synth_truth");
+  const auto cloud = dir / "plot.ply";
+  const CliRun synth = runFieldrig(
+      {"traits", "synth", "--out", cloud.string(), "--truth", "/proc/no-such/truth.json"},
+      dir.path());
+  EXPECT_EQ(synth.exit_code, 2);
+  EXPECT_NE(synth.err.find("/proc/no-such/truth.json"), std::string::npos) << synth.err;
+  EXPECT_FALSE(std::filesystem::exists(cloud));
+}
+
 // `fieldrig` is a launcher: `traits` runs the light fieldrig-traits, everything else (and
 // `traits synth`) the full fieldrig-commands. The light program's help says where the rest is.
 TEST(TraitsCli, TraitsRunsTheLightProgramAndEverythingElseTheFullOne) {

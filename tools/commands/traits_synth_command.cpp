@@ -2,6 +2,7 @@
 // truth (sim/plots: the generator, and the trait definitions on its noise-free visible geometry).
 // Apart from `traits --cloud` because it writes PLY through the cloud library (OpenCV, PCL's I/O),
 // which the light `fieldrig-traits` does not link.
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -49,10 +50,8 @@ int runSynth(const SynthArgs& args) {
     p.b = plot.colors[i][2];
     out.push_back(p);
   }
-  if (auto saved = cloud::writePly(out, args.out); !saved) {
-    std::cerr << "fieldrig traits synth: " << saved.error().message << '\n';
-    return kExitBadInput;
-  }
+  // The truth first: a --truth that cannot be written leaves no cloud without its truth, and a
+  // cloud that cannot be written takes its new truth away again.
   if (!args.truth.empty()) {
     Json truth = sim::plotTruthJson(plot, options);
     truth["points"] = out.size();
@@ -62,6 +61,14 @@ int runSynth(const SynthArgs& args) {
       std::cerr << "fieldrig traits synth: " << written.error().message << '\n';
       return kExitBadInput;
     }
+  }
+  if (auto saved = cloud::writePly(out, args.out); !saved) {
+    std::cerr << "fieldrig traits synth: " << saved.error().message << '\n';
+    if (!args.truth.empty()) {
+      std::error_code ignored;
+      std::filesystem::remove(args.truth, ignored);
+    }
+    return kExitBadInput;
   }
   return kExitOk;
 }
