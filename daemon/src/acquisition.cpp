@@ -44,6 +44,8 @@ core::Result<std::unique_ptr<Acquisition>> Acquisition::create(
                                 acquisition->options_.writer);
   if (!opened)
     return opened.error();
+  if (opened->map_changed)
+    spdlog::warn("session reopened with another map: {}", *opened->map_changed);
   acquisition->next_trigger_id_ = opened->next_set_index + 1;
   return acquisition;
 }

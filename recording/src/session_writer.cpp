@@ -141,7 +141,24 @@ core::Result<OpenReport> SessionWriter::open(const fs::path& dir, const SessionI
       return core::Error{session_path.string() + ":1: not a JSON object"};
     if (!session.contains("reopened") || !session["reopened"].is_array())
       session["reopened"] = Json::array();
-    session["reopened"].push_back({{"time", nowIso()}, {"software_version", softwareVersion()}});
+    Json reopening = {{"time", nowIso()}, {"software_version", softwareVersion()}};
+    // Sets from here on were triggered from this map: when it is not the one session.json names
+    // (a map edited between starts, or another field's), the reopening records it and says so.
+    if (info.map_file) {
+      const std::string sha = detail::sha256File(*info.map_file, error);
+      if (sha.empty())
+        return core::Error{"map checksum: " + error};
+      const Json& recorded = session.contains("map") ? session["map"] : Json();
+      const bool same = recorded.is_object() && recorded.value("sha256", "") == sha;
+      if (!same) {
+        reopening["map"] = {{"path", info.map_file->string()}, {"sha256", sha}};
+        report.map_changed = session_path.string() + " names the map " +
+                             (recorded.is_object() ? recorded.dump() : std::string("null")) +
+                             "; sets from now on are triggered from " + info.map_file->string() +
+                             " (sha256 " + sha + ")";
+      }
+    }
+    session["reopened"].push_back(std::move(reopening));
   } else {
     // An empty index is what a start that failed before session.json was written leaves.
     if (fs::exists(index_path, ec) && fs::file_size(index_path, ec) > 0)

@@ -2,6 +2,7 @@
 // byte for byte, by set index, trigger id and location id; reopening continues; torn lines.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "recording/test_helpers.h"
@@ -224,6 +225,43 @@ TEST(SessionWriterTest, ReopenContinuesNumberingAndKeepsTheDescription) {
   EXPECT_EQ(reader->metadata().configuration["run"], 1);
   ASSERT_EQ(reader->metadata().raw["reopened"].size(), 1u);
   EXPECT_TRUE(reader->verify().ok());
+}
+
+// A session reopened with another map than the one it names records that map in its reopening
+// and reports it; the same map again records nothing new.
+TEST(SessionWriterTest, ReopeningWithAnotherMapRecordsAndReportsIt) {
+  ScopedTempDir tmp("rec_reopen_map");
+  const fs::path session = tmp / "s";
+  const fs::path map = tmp / "map.csv";
+  const fs::path other = tmp / "other.csv";
+  std::ofstream(map) << "id,lat,lon,heading\nA,42,-93,0\n";
+  std::ofstream(other) << "id,lat,lon,heading\nB,43,-93,0\n";
+  {
+    SessionWriter writer;
+    ASSERT_TRUE(writer.open(session, testInfo(map)));
+  }
+  {
+    SessionWriter writer;
+    core::Result<OpenReport> same = writer.open(session, testInfo(map));
+    ASSERT_TRUE(same) << same.error().message;
+    EXPECT_FALSE(same->map_changed);
+  }
+  {
+    SessionWriter writer;
+    core::Result<OpenReport> changed = writer.open(session, testInfo(other));
+    ASSERT_TRUE(changed) << changed.error().message;
+    ASSERT_TRUE(changed->map_changed);
+    EXPECT_NE(changed->map_changed->find("sets from now on are triggered from " + other.string()),
+              std::string::npos)
+        << *changed->map_changed;
+  }
+  core::Result<SessionReader> reader = SessionReader::open(session);
+  ASSERT_TRUE(reader) << reader.error().message;
+  const auto& reopened = reader->metadata().raw["reopened"];
+  ASSERT_EQ(reopened.size(), 2u);
+  EXPECT_FALSE(reopened[0].contains("map"));
+  EXPECT_EQ(reopened[1].at("map").at("path"), other.string());
+  EXPECT_EQ(reader->metadata().map_path, map.string()) << "the session's first map stays";
 }
 
 TEST(SessionWriterTest, TornLastLineIsIgnoredReportedAndCutOnReopen) {

@@ -24,6 +24,9 @@ struct OpenReport {
   std::uint64_t next_set_index = 0;     // the index the next write() gets
   std::optional<TornLine> torn_line;    // cut away from index.jsonl
   std::uint64_t leftovers_removed = 0;  // temporary or unindexed frame files of a crashed run
+  // Reopened with another map than session.json names (its "reopened" entry records the new one):
+  // what changed, to be said where the run's user sees it.
+  std::optional<std::string> map_changed;
 };
 
 enum class WriteStatus {
