@@ -374,19 +374,35 @@ core::Result<void> writeBatchJob(const BatchPlan& plan, const fs::path& job_dir)
     }
   }
   std::error_code ec;
+  // A job that cannot be written whole (a full disk) leaves no folder that looks like one: the
+  // folders made here are removed again (only when empty).
+  std::vector<fs::path> made;
+  for (const fs::path& dir : {batchLogsDir(job_dir), job_dir / "tasks", job_dir}) {
+    if (!fs::exists(dir, ec))
+      made.push_back(dir);
+  }
+  const auto removeEmptyFolders = [&] {
+    for (const fs::path& dir : made)
+      fs::remove(dir, ec);
+  };
   for (const fs::path& dir : {job_dir / "tasks", batchLogsDir(job_dir)}) {
     fs::create_directories(dir, ec);
-    if (ec)
-      return core::Error{dir.string() + ": cannot create folder: " + ec.message()};
+    if (ec) {
+      const std::string reason = ec.message();
+      removeEmptyFolders();
+      return core::Error{dir.string() + ": cannot create folder: " + reason};
+    }
   }
-  if (std::string failed =
-          core::replaceFileAtomically(batchPlanFile(job_dir), batchPlanToJson(plan).dump(1) + "\n");
-      !failed.empty())
-    return core::Error{failed};
+  // The plan and its script belong together: both are written before either replaces the old.
   const fs::path script = job_dir / "job.sbatch";
-  if (std::string failed = core::replaceFileAtomically(script, batchSbatchScript(plan, job_dir));
-      !failed.empty())
+  const std::string plan_text = batchPlanToJson(plan).dump(1) + "\n";
+  const std::string script_text = batchSbatchScript(plan, job_dir);
+  if (std::string failed =
+          core::replaceFilesTogether({{batchPlanFile(job_dir), plan_text}, {script, script_text}});
+      !failed.empty()) {
+    removeEmptyFolders();
     return core::Error{failed};
+  }
   fs::permissions(script, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec,
                   fs::perm_options::add, ec);
   return {};

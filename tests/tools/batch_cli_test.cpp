@@ -192,6 +192,18 @@ TEST_F(BatchCli, MissingSessionsAndAbsentPlotsAreNamed) {
             std::string::npos)
       << injected.err;
   EXPECT_FALSE(fs::exists(dir.path() / "injected" / "job.sbatch"));
+  // A plan that cannot be written whole (a full disk; here a 1 KiB file size limit) leaves no
+  // job folder behind.
+  const fs::path full = dir.path() / "full";
+  const auto no_room = testing_support::runProgram(
+      "bash",
+      {"-c", "trap '' XFSZ; ulimit -f 1; exec \"$0\" \"$@\"", testing_support::kFieldrigBinary,
+       "batch", "plan", (root() / "day-a").string(), (root() / "day-b").string(), "--out",
+       full.string()},
+      dir.path());
+  EXPECT_NE(no_room.exit_code, 0);
+  EXPECT_NE(no_room.err.find("File too large"), std::string::npos) << no_room.err;
+  EXPECT_FALSE(fs::exists(full)) << "a half-made job folder";
 
   // A copy of day-b, to take away after the plan.
   const fs::path day_b = dir.path() / "day-b";
