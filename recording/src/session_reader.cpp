@@ -173,7 +173,15 @@ VerifyReport SessionReader::verify() const {
         report.problems.push_back(image.error().message);
         continue;
       }
-      report.bytes_checked += frame.file_bytes;
+      // The index's size is what `session info` and the stem tool report: a size the file does
+      // not have is a damaged index line even when the pixels are whole.
+      std::error_code ec;
+      const std::uintmax_t bytes = fs::file_size(dir_ / frame.file, ec);
+      if (!ec && bytes != frame.file_bytes) {
+        report.problems.push_back((dir_ / frame.file).string() + ": " + std::to_string(bytes) +
+                                  " bytes, the index says " + std::to_string(frame.file_bytes));
+      }
+      report.bytes_checked += ec ? frame.file_bytes : bytes;
       const std::uint32_t crc = detail::crc32(image->pixels);
       if (crc != frame.crc32) {
         char text[64];

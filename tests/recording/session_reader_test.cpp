@@ -155,6 +155,25 @@ TEST(SessionReaderTest, HeaderThatDisagreesWithTheIndexIsNamed) {
   EXPECT_TRUE(contains(report.problems[0], "30x40")) << report.problems[0];
 }
 
+// An index line whose file size is not the file's, with whole pixels: verify said ok.
+TEST(SessionReaderTest, AFileSizeThatDisagreesWithTheIndexIsNamed) {
+  ScopedTempDir tmp("reader_file_bytes");
+  const fs::path session = tmp / "s";
+  writeSession(session, 1);
+  const fs::path index = session / "index.jsonl";
+  const std::string text = readWholeFile(index);
+  const auto at = text.find("\"file_bytes\":");
+  ASSERT_NE(at, std::string::npos);
+  const auto end = text.find(',', at);
+  writeText(index, text.substr(0, at) + "\"file_bytes\":1000000000000000" + text.substr(end));
+  core::Result<SessionReader> reader = SessionReader::open(session);
+  ASSERT_TRUE(reader) << reader.error().message;
+  const VerifyReport report = reader->verify();
+  ASSERT_EQ(report.problems.size(), 1u);
+  EXPECT_TRUE(contains(report.problems[0], "bytes, the index says 1000000000000000"))
+      << report.problems[0];
+}
+
 }  // namespace
 }  // namespace fieldrig::recording
 
