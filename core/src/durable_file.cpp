@@ -108,8 +108,10 @@ std::string replaceFilesTogether(std::initializer_list<FileContent> files) {
     }
   }
   for (const FileContent& file : files) {
-    if (failed.empty() && ::rename(tempPathOf(file.path).c_str(), file.path.c_str()) != 0)
-      failed = file.path.string() + ": cannot write: " + std::strerror(errno);
+    if (failed.empty() && ::rename(tempPathOf(file.path).c_str(), file.path.c_str()) != 0) {
+      const int error = errno;
+      failed = file.path.string() + ": cannot write: " + std::strerror(error);
+    }
     if (!failed.empty())
       ::unlink(tempPathOf(file.path).c_str());
   }
@@ -123,19 +125,37 @@ std::string replaceFilesTogether(std::initializer_list<FileContent> files) {
 }
 
 std::string writeWholeFile(const std::filesystem::path& path, std::string_view data) {
+  // lstat: a symbolic link (/dev/stdout), a device or a pipe is written through in place; only a
+  // plain file, or a new one, is replaced by a renamed temporary file.
   struct stat info {};
-  const bool in_place = ::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode);
-  const std::filesystem::path target = in_place ? path : tempPathOf(path);
-  bool created = false;
-  const int error = writeAndClose(target, data, false, created);
-  if (!created)
-    return path.string() + ": cannot create: " + std::strerror(error);
-  if (error == 0 && (in_place || ::rename(target.c_str(), path.c_str()) == 0))
+  const bool exists = ::lstat(path.c_str(), &info) == 0;
+  if (exists && !S_ISREG(info.st_mode)) {
+    bool created = false;
+    const int error = writeAndClose(path, data, false, created);
+    if (!created)
+      return path.string() + ": cannot create: " + std::strerror(error);
+    if (error != 0)
+      return path.string() + ": cannot write: " + std::strerror(error);
     return {};
-  const int failure = error != 0 ? error : errno;
-  if (!in_place)
-    ::unlink(target.c_str());
-  return path.string() + ": cannot write: " + std::strerror(failure);
+  }
+  // A name of its own (mkstemp), so that no file already there is truncated or followed.
+  std::string temp = path.string() + ".tmp.XXXXXX";
+  const int fd = ::mkstemp(temp.data());
+  if (fd < 0)
+    return path.string() + ": cannot create: " + std::strerror(errno);
+  int error = ::fchmod(fd, 0644) == 0 ? 0 : errno;
+  if (error == 0)
+    error = writeFully(fd, data.data(), data.size());
+  // close() reports what a network or full file system deferred.
+  if (::close(fd) != 0 && error == 0)
+    error = errno;
+  if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0)
+    error = errno;
+  if (error != 0) {
+    ::unlink(temp.c_str());
+    return path.string() + ": cannot write: " + std::strerror(error);
+  }
+  return {};
 }
 
 std::string appendDurably(const std::filesystem::path& path, std::string_view text) {

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -137,13 +138,23 @@ TEST(DurableFileTest, AWholeFileWriteThatFailsKeepsTheOldFile) {
   EXPECT_EQ(failed.rfind(path.string() + ": cannot write: ", 0), 0u) << failed;
   EXPECT_NE(failed.find(std::strerror(EFBIG)), std::string::npos) << failed;
   EXPECT_EQ(read(path), "the old content");
-  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
   {
     const testing_support::FileSizeLimit limit(64);
     EXPECT_NE(writeWholeFile(dir / "new.ply", std::string(4096, 'x')), "");
   }
   EXPECT_FALSE(fs::exists(dir / "new.ply"));
-  EXPECT_FALSE(fs::exists(dir / "new.ply.tmp"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1)
+      << "no temporary file is left";
+  // A file already named like a temporary one is not touched, and a symbolic link is written
+  // through to its target (/dev/stdout is one), not replaced by a file.
+  std::ofstream(path.string() + ".tmp") << "someone else's";
+  const fs::path link = dir / "link.ply";
+  fs::create_symlink(path, link);
+  ASSERT_EQ(writeWholeFile(link, "through the link"), "");
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(read(path), "through the link");
+  ASSERT_EQ(writeWholeFile(path, "new"), "");
+  EXPECT_EQ(read(path.string() + ".tmp"), "someone else's");
 }
 
 // Files that belong together: when one cannot be written, none is replaced.

@@ -27,7 +27,8 @@ std::string replaceFileAtomically(const std::filesystem::path& path, std::string
 
 // Files that belong together (a calibration's two): every temporary file is written and synced
 // before the first rename, so a write that fails (a full disk) leaves all the old files as they
-// were. Only a crash between the renames can leave some new and some old.
+// were. Only a crash between the renames, or a rename that fails after another went through (a
+// target that became a folder), can leave some new and some old.
 struct FileContent {
   std::filesystem::path path;
   std::string_view text;
@@ -35,9 +36,10 @@ struct FileContent {
 std::string replaceFilesTogether(std::initializer_list<FileContent> files);
 
 // Writes `data` to `path` and checks that every byte and the close went through; no fsync: for
-// outputs that are remade by running again (rendered images, maps, clouds). A regular file (or a
-// new one) is written beside as PATH.tmp and renamed over it, so a failed write leaves the old
-// file whole and no partial one; anything else (/dev/stdout, a pipe) is written in place.
+// outputs that are remade by running again (rendered images, maps, clouds). A plain file (or a
+// new one) is written beside under a name of its own (PATH.tmp.XXXXXX) and renamed over it, so a
+// failed write leaves the old file whole and no partial one; anything else (a symbolic link such
+// as /dev/stdout, a device, a pipe) is written through in place.
 // Empty on success, else "PATH: reason".
 std::string writeWholeFile(const std::filesystem::path& path, std::string_view data);
 
