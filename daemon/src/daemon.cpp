@@ -36,6 +36,7 @@
 #include "fieldrig/daemon/status_server.h"
 #include "fieldrig/gps/local_frame.h"
 #include "fieldrig/gps/location_map.h"
+#include "fieldrig/gps/serial_nmea_source.h"
 #include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/gps/trigger_replay.h"
 #include "fieldrig/pipeline/plot_processor.h"
@@ -203,6 +204,17 @@ class Daemon {
         return kExitBadInput;
       }
     }
+    // A device must be a serial port: /dev/null would be opened again and again for ever.
+    const fs::path& nmea_input =
+        options_.mode == Mode::kReplay ? config_.replay.nmea : fs::path(config_.gps.serial.device);
+    if (std::error_code ec; fs::is_character_file(nmea_input, ec)) {
+      if (auto serial = gps::checkSerialDevice(nmea_input.string()); !serial) {
+        spdlog::error("{}: {}: {}", sourceName(),
+                      options_.mode == Mode::kReplay ? "replay.nmea" : "gps.serial.device",
+                      serial.error().message);
+        return kExitBadInput;
+      }
+    }
     if (config_.recording.dir.empty()) {
       spdlog::error("{}: recording.dir: no session folder configured", sourceName());
       return kExitBadInput;
@@ -282,8 +294,13 @@ class Daemon {
     // on a first start) are removed again, when still empty, if the start fails below: a failed
     // start leaves nothing written.
     FoldersIfStartFails new_folders;
-    for (fs::path folder = fs::absolute(results_dir).lexically_normal();
-         folder.has_relative_path() && !fs::exists(folder); folder = folder.parent_path())
+    std::error_code absolute_error, missing;
+    const fs::path results_absolute = fs::absolute(results_dir, absolute_error).lexically_normal();
+    // Only what is not there at all (a dangling link to an unmounted disk is there, and stays).
+    for (fs::path folder = results_absolute;
+         !absolute_error && folder.has_relative_path() &&
+         fs::symlink_status(folder, missing).type() == fs::file_type::not_found;
+         folder = folder.parent_path())
       new_folders.folders.push_back(folder);
     if (processor_) {
       auto results = ResultsWriter::open(results_dir, results_options);

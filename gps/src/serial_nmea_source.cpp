@@ -98,6 +98,17 @@ void SerialNmeaSource::stop() {
   port_.close(ignored);
 }
 
+core::Result<void> checkSerialDevice(const std::string& device) {
+  const int fd = ::open(device.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0)
+    return {};
+  const bool terminal = ::isatty(fd) == 1;
+  ::close(fd);
+  if (!terminal)
+    return core::Error{device + ": a character device but not a serial port (not a terminal)"};
+  return {};
+}
+
 void SerialNmeaSource::closePort() {
   boost::system::error_code ignored;
   port_.close(ignored);

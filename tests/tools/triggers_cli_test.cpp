@@ -201,5 +201,14 @@ TEST_F(TriggersCliTest, MissingNmeaFileIsAnErrorNamingIt) {
   EXPECT_NE(run.err.find("nowhere.nmea"), std::string::npos) << run.err;
 }
 
+// A character device that is no serial port was opened again and again until killed.
+TEST_F(TriggersCliTest, ADeviceThatIsNoSerialPortIsAnErrorNamingIt) {
+  const auto run =
+      runFieldrig({"triggers", "--map", (dir_ / "map.csv").string(), "--nmea", "/dev/null"}, dir_);
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("/dev/null: a character device but not a serial port"), std::string::npos)
+      << run.err;
+}
+
 }  // namespace
 }  // namespace fieldrig

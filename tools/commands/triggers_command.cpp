@@ -11,6 +11,7 @@
 
 #include "commands/command_helpers.h"
 #include "fieldrig/gps/location_map.h"
+#include "fieldrig/gps/serial_nmea_source.h"
 #include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/gps/trigger_replay.h"
 
@@ -115,8 +116,12 @@ int runTriggers(const TriggersArgs& args) {
     return kExitBadInput;
   }
   std::error_code type_error;  // an unreadable path is reported below as "cannot open"
-  if (std::filesystem::is_character_file(args.nmea_path, type_error))
+  if (std::filesystem::is_character_file(args.nmea_path, type_error)) {
+    // /dev/null is a character device too: opened as a port again and again for ever.
+    if (auto serial = gps::checkSerialDevice(args.nmea_path); !serial)
+      return fail("fieldrig triggers: --nmea: ", serial.error().message);
     return runLive(args, *map);
+  }
   std::ifstream nmea;
   if (const std::string problem = openInputFile(args.nmea_path, nmea); !problem.empty())
     return fail("fieldrig triggers: NMEA file: ", problem);

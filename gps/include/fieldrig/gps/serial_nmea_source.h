@@ -42,6 +42,12 @@ struct SerialStatus {
   std::chrono::milliseconds retry_in{0};  // kLost / kOpenFailed: when the next open is tried
 };
 
+// A character device that is not a terminal (/dev/null, /dev/zero) is no receiver's serial
+// port, and opening it again would go on for ever: the error names it. A device that is not there
+// (a USB adapter not plugged in yet) or cannot be opened now is not refused here: the source
+// waits for it and reports each attempt.
+core::Result<void> checkSerialDevice(const std::string& device);
+
 class SerialNmeaSource {
  public:
   // Every line the parser completes is passed on, rejected ones included (the consumer decides
