@@ -11,6 +11,7 @@
 
 #include "commands/command_helpers.h"
 #include "fieldrig/cloud/fusion.h"
+#include "fieldrig/core/durable_file.h"
 #include "fieldrig/sim/plot_generator.h"
 #include "fieldrig/sim/plot_truth.h"
 #include "fieldrig/traits/plot_report.h"
@@ -50,24 +51,25 @@ int runSynth(const SynthArgs& args) {
     p.b = plot.colors[i][2];
     out.push_back(p);
   }
-  // The truth first: a --truth that cannot be written leaves no cloud without its truth, and a
-  // cloud that cannot be written takes its new truth away again.
-  if (!args.truth.empty()) {
-    Json truth = sim::plotTruthJson(plot, options);
-    truth["points"] = out.size();
-    truth["frame"] = args.frame;
-    core::Result<void> written = traits::writeText(args.truth, truth.dump(1) + "\n");
-    if (!written) {
-      std::cerr << "fieldrig traits synth: " << written.error().message << '\n';
+  if (args.truth.empty()) {
+    if (auto saved = cloud::writePly(out, args.out); !saved) {
+      std::cerr << "fieldrig traits synth: " << saved.error().message << '\n';
       return kExitBadInput;
     }
+    return kExitOk;
   }
-  if (auto saved = cloud::writePly(out, args.out); !saved) {
-    std::cerr << "fieldrig traits synth: " << saved.error().message << '\n';
-    if (!args.truth.empty()) {
-      std::error_code ignored;
-      std::filesystem::remove(args.truth, ignored);
-    }
+  Json truth = sim::plotTruthJson(plot, options);
+  truth["points"] = out.size();
+  truth["frame"] = args.frame;
+  // The cloud and its truth replace the old pair together: one that cannot be written (a full
+  // disk, a --truth in a folder that is not there) leaves the old pair, never a mixed one.
+  const std::string cloud_bytes = cloud::plyBytes(out);
+  const std::string truth_text = truth.dump(1) + "\n";
+  if (std::string failed =
+          core::replaceFilesTogether({{std::filesystem::path(args.out), cloud_bytes},
+                                      {std::filesystem::path(args.truth), truth_text}});
+      !failed.empty()) {
+    std::cerr << "fieldrig traits synth: " << failed << '\n';
     return kExitBadInput;
   }
   return kExitOk;

@@ -237,19 +237,15 @@ FusionResult CloudBuilder::build(const std::vector<HeadFrames>& frames, bool par
   return result;
 }
 
-core::Result<std::filesystem::path> writePly(const Cloud& cloud,
-                                             const std::filesystem::path& file) {
-  if (cloud.empty()) {
-    return core::Error{file.string() + ": the cloud is empty; nothing to write"};
-  }
-  // Written here, not by pcl::PLYWriter: PCL's writer truncates the file in place and reports
+std::string plyBytes(const Cloud& cloud) {
+  // Built here, not by pcl::PLYWriter: PCL's writer truncates the file in place and reports
   // success after a short write (a full disk), which left a cut cloud where the old one was. The
   // format is PCL's own for this point type without its "camera" element: a plain vertex list
   // with red/green/blue that every PLY reader takes.
   static_assert(std::endian::native == std::endian::little, "binary_little_endian is written");
   std::string bytes =
-      "ply\nformat binary_little_endian 1.0\ncomment fieldrig fused cloud, plot "
-      "frame, metres\nelement vertex " +
+      "ply\nformat binary_little_endian 1.0\ncomment fieldrig cloud, metres\n"
+      "element vertex " +
       std::to_string(cloud.size()) +
       "\nproperty float x\nproperty float y\nproperty float z\n"
       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
@@ -264,7 +260,15 @@ core::Result<std::filesystem::path> writePly(const Cloud& cloud,
     std::memcpy(&bytes[at + sizeof xyz], rgb, sizeof rgb);
     at += kVertexBytes;
   }
-  if (std::string failed = core::writeWholeFile(file, bytes); !failed.empty())
+  return bytes;
+}
+
+core::Result<std::filesystem::path> writePly(const Cloud& cloud,
+                                             const std::filesystem::path& file) {
+  if (cloud.empty()) {
+    return core::Error{file.string() + ": the cloud is empty; nothing to write"};
+  }
+  if (std::string failed = core::writeWholeFile(file, plyBytes(cloud)); !failed.empty())
     return core::Error{std::move(failed)};
   return file;
 }

@@ -101,7 +101,10 @@ class CloudBuilder {
   std::vector<cv::Matx44d> to_plot_;  // head frame → plot frame
 };
 
-// Writes the cloud as binary PLY (x y z and rgb), which CloudCompare and MeshLab read.
+// The cloud as binary little-endian PLY (x y z float, red green blue uchar, metres), which
+// CloudCompare, MeshLab and PCL read.
+std::string plyBytes(const Cloud& cloud);
+// Writes plyBytes() whole or not at all (core::writeWholeFile); an empty cloud is an error.
 core::Result<std::filesystem::path> writePly(const Cloud& cloud, const std::filesystem::path& file);
 
 }  // namespace fieldrig::cloud
