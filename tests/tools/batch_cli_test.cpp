@@ -168,7 +168,7 @@ TEST_F(BatchCli, LocalRunMergesToTheSerialResultAndIsIdempotent) {
                                                   "\"height_m\":\"tall\"");
   const auto worded = runFieldrig({"batch", "merge", job.string()}, dir.path());
   EXPECT_EQ(worded.exit_code, 3);
-  EXPECT_NE(worded.err.find("traits.height_m: \"tall\" is not a number"), std::string::npos)
+  EXPECT_NE(worded.err.find("traits: 'height_m' is \"tall\", not a number"), std::string::npos)
       << worded.err;
   EXPECT_EQ(readWholeFile(job / "merged" / "season.jsonl"), jsonl);
 }

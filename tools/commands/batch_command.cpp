@@ -423,9 +423,11 @@ int runTask(const BatchArgs& args) {
   if (!plan)
     return fail(who, plan.error().message);
   if (args.task >= plan->tasks.size()) {
-    return fail(who, "task " + std::to_string(args.task) + ": the plan has " +
-                         std::to_string(plan->tasks.size()) + " tasks (0 to " +
-                         std::to_string(plan->tasks.size() - 1) + ")");
+    return fail(
+        who, "task " + std::to_string(args.task) + ": the plan has " +
+                 std::to_string(plan->tasks.size()) + " tasks" +
+                 (plan->tasks.empty() ? std::string()
+                                      : " (0 to " + std::to_string(plan->tasks.size() - 1) + ")"));
   }
   const fs::path job_dir = fs::absolute(args.job_dir).lexically_normal();
   auto done = daemon::runBatchTask(*plan, job_dir, args.task,

@@ -146,24 +146,17 @@ PlotRow toPlotRow(const PlotRecord& record) {
 core::Result<PlotRow> plotRowFromJson(const std::string& plot_id, const std::string& time,
                                       double lat_deg, double lon_deg,
                                       const nlohmann::ordered_json& traits_json) {
-  // The tables take the values as they are: a word where a number belongs would reach the
-  // season's CSV as a trait.
-  const auto notNumber = [](const Json& object, const char* key) {
-    return object.is_object() && object.contains(key) && !object.at(key).is_number() &&
-           !object.at(key).is_null();
-  };
-  for (const char* key :
-       {"height_m", "width_m", "vvi", "vai", "total_volume_m3", "total_area_m2", "ega_m2"}) {
-    if (notNumber(traits_json, key)) {
-      return core::Error{std::string("traits.") + key + ": " + traits_json.at(key).dump() +
-                         " is not a number"};
-    }
-  }
-  if (traits_json.is_object() && traits_json.contains("status") &&
-      !traits_json.at("status").is_string())
-    return core::Error{"traits.status: " + traits_json.at("status").dump() + " is not a string"};
   try {
-    return PlotRow{lat_deg, lon_deg, flatFromTraitsJson(plot_id, time, traits_json)};
+    Json flat = flatFromTraitsJson(plot_id, time, traits_json);
+    // The tables take the values as they are: a word where a number belongs would reach the
+    // season's CSV as a trait.
+    for (const auto& [key, value] : flat.items()) {
+      const bool text = key == "plot_id" || key == "time" || key == "status";
+      if (text ? !value.is_string() : !(value.is_number() || value.is_null()))
+        return core::Error{"traits: '" + key + "' is " + value.dump() + ", not " +
+                           (text ? "a string" : "a number")};
+    }
+    return PlotRow{lat_deg, lon_deg, std::move(flat)};
   } catch (const nlohmann::json::exception& error) {
     return core::Error{std::string("traits: ") + error.what()};
   }
