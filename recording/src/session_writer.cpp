@@ -148,8 +148,15 @@ core::Result<OpenReport> SessionWriter::open(const fs::path& dir, const SessionI
       const std::string sha = detail::sha256File(*info.map_file, error);
       if (sha.empty())
         return core::Error{"map checksum: " + error};
-      const Json& recorded = session.contains("map") ? session["map"] : Json();
-      const bool same = recorded.is_object() && recorded.value("sha256", "") == sha;
+      // The map in use so far: the last reopening's that recorded one, else the session's own.
+      Json recorded = session.contains("map") ? session["map"] : Json();
+      for (const Json& earlier : session["reopened"]) {
+        if (earlier.is_object() && earlier.contains("map"))
+          recorded = earlier["map"];
+      }
+      const bool same = recorded.is_object() && recorded.contains("sha256") &&
+                        recorded["sha256"].is_string() &&
+                        recorded["sha256"].get<std::string>() == sha;
       if (!same) {
         reopening["map"] = {{"path", info.map_file->string()}, {"sha256", sha}};
         report.map_changed = session_path.string() + " names the map " +

@@ -255,10 +255,17 @@ TEST(SessionWriterTest, ReopeningWithAnotherMapRecordsAndReportsIt) {
               std::string::npos)
         << *changed->map_changed;
   }
+  {  // the new map again: it is the one in use, nothing new to record
+    SessionWriter writer;
+    core::Result<OpenReport> again = writer.open(session, testInfo(other));
+    ASSERT_TRUE(again) << again.error().message;
+    EXPECT_FALSE(again->map_changed);
+  }
   core::Result<SessionReader> reader = SessionReader::open(session);
   ASSERT_TRUE(reader) << reader.error().message;
   const auto& reopened = reader->metadata().raw["reopened"];
-  ASSERT_EQ(reopened.size(), 2u);
+  ASSERT_EQ(reopened.size(), 3u);
+  EXPECT_FALSE(reopened[2].contains("map"));
   EXPECT_FALSE(reopened[0].contains("map"));
   EXPECT_EQ(reopened[1].at("map").at("path"), other.string());
   EXPECT_EQ(reader->metadata().map_path, map.string()) << "the session's first map stays";
