@@ -138,8 +138,9 @@ TEST(StereoCli, BadInputIsAClearError) {
                    kData + "middlebury2003/teddy/im6.png", "--out", own_left.string()},
                   dir.path());
   EXPECT_EQ(onto_input.exit_code, 2);
-  EXPECT_NE(onto_input.err.find("--out " + own_left.string() + " is the input image"),
-            std::string::npos)
+  EXPECT_NE(
+      onto_input.err.find("--out " + own_left.string() + " is the input " + own_left.string()),
+      std::string::npos)
       << onto_input.err;
   EXPECT_EQ(readWholeFile(own_left), left_before);
 

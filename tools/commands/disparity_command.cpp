@@ -32,12 +32,11 @@ int runDisparity(const DisparityArgs& args) {
     std::cerr << who << args.left << ": cannot read the image\n";
     return kExitBadInput;
   }
-  // The PFM replaces --out whole: given an input's path it would overwrite that image.
-  for (const std::string& input : {args.left, args.right}) {
+  // The PFM replaces --out whole: given an input's path it would overwrite that input.
+  for (const std::string& input : {args.left, args.right, args.intrinsics, args.extrinsics}) {
     std::error_code ec;
-    if (std::filesystem::equivalent(args.out, input, ec))
-      return fail(who,
-                  "--out " + args.out + " is the input image " + input + ": give another file");
+    if (!input.empty() && std::filesystem::equivalent(args.out, input, ec))
+      return fail(who, "--out " + args.out + " is the input " + input + ": give another file");
   }
   const cv::Mat right = cv::imread(args.right, cv::IMREAD_COLOR);
   if (right.empty()) {
