@@ -12,6 +12,7 @@
 
 #include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/config/config.h"
+#include "fieldrig/core/command_line.h"
 #include "fieldrig/core/exception_message.h"
 #include "fieldrig/core/logging.h"
 #include "fieldrig/daemon/daemon.h"
@@ -73,7 +74,8 @@ int runMain(int argc, char** argv, bool& logging_ready) {
   bool realtime = false, quiet = false, no_status = false;
   auto add_common = [&](CLI::App* mode) {
     mode->add_option("--config", config_path, "The YAML configuration")->required();
-    mode->add_option("--log-level", log_level, "trace, debug, info, warn, error");
+    fieldrig::core::addLogLevelOption(*mode, log_level,
+                                      "trace, debug, info, warn, error (overrides log.level)");
     mode->add_option("--recording", recording, "Session folder (overrides recording.dir)");
     mode->add_option("--map", map, "Imaging-location map (overrides map)");
     mode->add_option("--calibration", calibration, "Calibration folder (overrides calibration)");
@@ -98,6 +100,7 @@ int runMain(int argc, char** argv, bool& logging_ready) {
                    "Play a file at its own pace (overrides replay.realtime)");
   app.require_subcommand(0, 1);
   try {
+    fieldrig::core::refuseEmptyValues(app);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     // --help is a ParseError with exit code 0; every other one is an option that cannot be used,

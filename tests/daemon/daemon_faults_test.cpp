@@ -118,6 +118,24 @@ TEST_F(DaemonFaults, AnNmeaFolderIsNamedAndNothingIsWritten) {
   EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a folder as NMEA wrote something";
 }
 
+// An empty override read as "not given" (`--recording ''` recorded into the configuration's
+// folder), and spdlog read an unknown level as "off" (`--log-level loud` silenced the log).
+TEST_F(DaemonFaults, AnEmptyOverrideOrAnUnknownLogLevelIsRefusedAndNothingIsWritten) {
+  ScopedTempDir dir("daemon_empty_override");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  const auto empty =
+      runDaemon({"replay", "--config", config.string(), "--recording", ""}, dir.path());
+  EXPECT_EQ(empty.exit_code, 2);
+  EXPECT_NE(empty.err.find("fieldrigd replay: --recording: must not be empty"), std::string::npos)
+      << empty.err;
+  const auto loud =
+      runDaemon({"replay", "--config", config.string(), "--log-level", "loud"}, dir.path());
+  EXPECT_EQ(loud.exit_code, 2);
+  EXPECT_NE(loud.err.find("--log-level"), std::string::npos) << loud.err;
+  EXPECT_NE(loud.err.find("loud"), std::string::npos) << loud.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a refused option wrote something";
+}
+
 // Cameras for a head the calibration does not have, and none for one it has: every plot went
 // without that head, with exit 0 and an --check-config that said ok.
 TEST_F(DaemonFaults, ACalibratedHeadWithoutCamerasIsNamedAndNothingIsWritten) {

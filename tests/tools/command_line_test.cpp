@@ -43,6 +43,8 @@ Outcome runWith(std::vector<std::string> words) {
   CLI::App app{"test"};
   app.require_subcommand(1);
   int exit_code = kExitOk;
+  std::string log_level = "warn";
+  addLogLevelOption(app, log_level);
   CLI::App* sim = addCommandGroup(app, "sim", "group");
   const auto [drive, args] = addSubcommand(*sim, "drive", "a command", exit_code, run);
   drive->add_option("--rate", args->rate)->check(finiteRange(0.01, 1000.0));
@@ -74,6 +76,15 @@ TEST(RunCommandLine, AnEmptyValueIsRefusedNamingTheOption) {
             "fieldrig sim drive: --what: must not be empty (fieldrig sim drive --help lists the "
             "options)\n");
   EXPECT_EQ(runWith({"sim", "drive", "--what", "x"}).exit_code, kExitOk);
+}
+
+// spdlog reads a level it does not know as "off": `--log-level loud` silenced the log.
+TEST(RunCommandLine, AnUnknownLogLevelIsRefused) {
+  const Outcome loud = runWith({"--log-level", "loud", "sim", "drive"});
+  EXPECT_EQ(loud.exit_code, kExitBadInput);
+  EXPECT_EQ(loud.err.rfind("fieldrig sim drive: --log-level: loud not in", 0), 0u) << loud.err;
+  EXPECT_EQ(runWith({"--log-level", "debug", "sim", "drive"}).exit_code, kExitOk);
+  EXPECT_EQ(runWith({"--log-level", "", "sim", "drive"}).exit_code, kExitBadInput);
 }
 
 TEST(RunCommandLine, AnOptionCli11RefusesIsOneLineNamingTheCommand) {

@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "commands/commands.h"
+#include "fieldrig/core/command_line.h"
 #include "fieldrig/core/exception_message.h"
 #include "fieldrig/core/logging.h"
 
@@ -111,27 +112,8 @@ inline std::string commandName(const CLI::App& app, const std::string& program) 
 // The top-level --log-level option of every fieldrig program; logging is set up once the command
 // line is parsed.
 inline void addLogLevelOption(CLI::App& app, std::string& log_level) {
-  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
-      ->capture_default_str();
+  core::addLogLevelOption(app, log_level, "trace, debug, info, warn, error")->capture_default_str();
   app.parse_complete_callback([&log_level] { core::setupLogging(log_level); });
-}
-
-// An empty value ("--shard ''", "--out ''", an empty positional) is refused for every option
-// that takes one, here and its subcommands': the commands test their string options for
-// emptiness to mean "not given", so an empty value would silently act as no option at all
-// (`--shard ''` processed every set in every array task).
-inline void refuseEmptyValues(CLI::App& app) {
-  const CLI::Validator non_empty(
-      [](std::string& input) {
-        return input.empty() ? std::string("must not be empty") : std::string{};
-      },
-      "");
-  for (CLI::Option* option : app.get_options()) {
-    if (option->get_type_size_max() > 0)
-      option->check(non_empty);
-  }
-  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
-    refuseEmptyValues(*sub);
 }
 
 // main(): parses the command line, whose subcommand callbacks run the command and set
@@ -141,7 +123,7 @@ inline void refuseEmptyValues(CLI::App& app) {
 inline int runCommandLine(CLI::App& app, const std::string& program, int argc,
                           const char* const* argv, const int& exit_code) {
   try {
-    refuseEmptyValues(app);
+    core::refuseEmptyValues(app);
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0)
