@@ -184,6 +184,20 @@ TEST(MapCli, GenerateRejectsABadPlan) {
   EXPECT_NE(run.err.find("--row-start"), std::string::npos) << run.err;
 }
 
+// An output that cannot be written is a file that cannot be used (exit 2, naming it), as in the
+// other commands; it was exit 3, the code for a failure while running.
+TEST(MapCli, GenerateIntoAnUnwritablePlaceIsBadInputNamingIt) {
+  const ScopedTempDir dir("map_cli_generate_unwritable");
+  const std::filesystem::path out = dir / "no-such-folder" / "map.csv";
+  const auto run = runFieldrig({"map", "generate", "--row-start", "42.0105,-93.7452", "--row-end",
+                                "42.0110,-93.7445", "--rows", "1", "--plot-length", "3",
+                                "--alley-length", "1", "--row-spacing", "2", "--out", out},
+                               dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find(out.string()), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out.parent_path()));
+}
+
 // ---------------------------------------------------------------------------------------------
 // map record
 

@@ -51,7 +51,7 @@ int runGenerate(const GenerateOptions& options) {
     return fail("fieldrig map generate: ", map.error().message);
   auto saved = map->save(options.out);
   if (!saved)
-    return fail("fieldrig map generate: ", saved.error().message, kExitRuntime);
+    return fail("fieldrig map generate: ", saved.error().message);
   Json summary;
   summary["out"] = options.out;
   summary["locations"] = map->size();

@@ -50,10 +50,10 @@ int runDrive(const DriveArgs& args) {
   nmea.close();
   if (!nmea) {
     std::cerr << kName << "cannot write '" << args.out_nmea << "'\n";
-    return kExitRuntime;
+    return kExitBadInput;
   }
   if (const auto saved = map->save(args.out_map); !saved)
-    return fail(kName, saved.error().message, kExitRuntime);
+    return fail(kName, saved.error().message);
   Json summary;
   summary["nmea"] = args.out_nmea;
   summary["map"] = args.out_map;
