@@ -73,12 +73,24 @@ core::UtcTime timeFrom(const Json& value, const char* what) {
   return *time;
 }
 
+// An angle in [-limit, limit] degrees, or an error naming the key: a damaged or hand-edited
+// latitude of 500 would place the set nowhere on Earth, and the map placement and the geodesic
+// distances after it would take it as given.
+double degreesWithin(const Json& value, const char* key, double limit) {
+  const double degrees = value.get<double>();
+  if (!(degrees >= -limit && degrees <= limit))
+    throw std::invalid_argument(std::string("'") + key + "' is " + value.dump() +
+                                ", not an angle in [-" + std::to_string(static_cast<int>(limit)) +
+                                ", " + std::to_string(static_cast<int>(limit)) + "] degrees");
+  return degrees;
+}
+
 core::GpsFix fixFrom(const Json& in) {
   core::GpsFix fix;
   fix.time = timeFrom(in.at("time"), "gps.time");
   fix.has_date = in.at("has_date").get<bool>();
-  fix.latitude_deg = in.at("lat").get<double>();
-  fix.longitude_deg = in.at("lon").get<double>();
+  fix.latitude_deg = degreesWithin(in.at("lat"), "gps.lat", 90.0);
+  fix.longitude_deg = degreesWithin(in.at("lon"), "gps.lon", 180.0);
   fix.valid = in.at("valid").get<bool>();
   fix.speed_mps = optionalFrom<double>(in, "speed_mps");
   fix.course_deg = optionalFrom<double>(in, "course_deg");

@@ -70,5 +70,38 @@ TEST(IndexLine, NumbersThatDoNotFitTheirFieldAreRefusedNamingTheKey) {
   }
 }
 
+// `session info --verify` passed a fix at latitude 500: no place on Earth, and the map placement
+// and geodesic distances after it took it as given.
+TEST(IndexLine, AFixOutsideTheEarthsAnglesIsRefusedNamingTheKey) {
+  IndexedSet set = oneFrameSet();
+  core::GpsFix fix;
+  fix.latitude_deg = 42.01;
+  fix.longitude_deg = -93.74;
+  fix.valid = true;
+  set.fix = fix;
+  const std::string line = toIndexLine(set);
+  std::string error;
+  ASSERT_TRUE(fromIndexLine(line, error)) << error;
+  const struct {
+    const char* from;
+    const char* to;
+    const char* key;
+  } cases[] = {
+      {"\"lat\":42.01", "\"lat\":500", "'gps.lat' is 500"},
+      {"\"lat\":42.01", "\"lat\":-90.5", "'gps.lat' is -90.5"},
+      {"\"lon\":-93.74", "\"lon\":180.25", "'gps.lon' is 180.25"},
+  };
+  for (const auto& c : cases) {
+    std::string damaged = line;
+    const std::size_t at = damaged.find(c.from);
+    ASSERT_NE(at, std::string::npos) << line;
+    damaged.replace(at, std::string(c.from).size(), c.to);
+    error.clear();
+    EXPECT_FALSE(fromIndexLine(damaged, error)) << damaged;
+    EXPECT_NE(error.find(c.key), std::string::npos) << error;
+    EXPECT_NE(error.find("degrees"), std::string::npos) << error;
+  }
+}
+
 }  // namespace
 }  // namespace fieldrig::recording
