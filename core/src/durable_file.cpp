@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 namespace fieldrig::core {
 
@@ -73,50 +74,79 @@ std::string replaceFileAtomically(const std::filesystem::path& path, std::string
 
 namespace {
 
-std::filesystem::path tempPathOf(const std::filesystem::path& path) {
-  return path.string() + ".tmp";
-}
-
-// Writes `data` to `path` (created or truncated), with an fsync when `sync`; 0 or the errno.
-int writeAndClose(const std::filesystem::path& path, std::string_view data, bool sync,
-                  bool& created) {
+// Writes `data` to `path` (created or truncated); 0 or the errno.
+int writeAndClose(const std::filesystem::path& path, std::string_view data, bool& created) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   created = fd >= 0;
   if (fd < 0)
     return errno;
   int error = writeFully(fd, data.data(), data.size());
-  if (error == 0 && sync && ::fsync(fd) != 0)
-    error = errno;
   // close() reports what a network or full file system deferred.
   if (::close(fd) != 0 && error == 0)
     error = errno;
   return error;
 }
 
+// A new file beside a target, holding its new content until it is renamed over it.
+struct TempBeside {
+  std::string name;    // PATH.tmp.XXXXXX; removed again when the write failed
+  std::string failed;  // "PATH: reason", or empty
+};
+
+// Writes `data` into a file beside `path` under a name of its own (mkstemp), so that no file
+// already there is truncated or followed through a link, and two writers never share one; synced
+// when `sync`.
+TempBeside writeBeside(const std::filesystem::path& path, std::string_view data, bool sync) {
+  TempBeside temp{path.string() + ".tmp.XXXXXX", {}};
+  const int fd = ::mkstemp(temp.name.data());
+  if (fd < 0) {
+    temp.failed = path.string() + ": cannot create: " + std::strerror(errno);
+    temp.name.clear();
+    return temp;
+  }
+  int error = ::fchmod(fd, 0644) == 0 ? 0 : errno;
+  if (error == 0)
+    error = writeFully(fd, data.data(), data.size());
+  if (error == 0 && sync && ::fsync(fd) != 0)
+    error = errno;
+  // close() reports what a network or full file system deferred.
+  if (::close(fd) != 0 && error == 0)
+    error = errno;
+  if (error != 0) {
+    ::unlink(temp.name.c_str());
+    temp.name.clear();
+    temp.failed = path.string() + ": cannot write: " + std::strerror(error);
+  }
+  return temp;
+}
+
 }  // namespace
 
 std::string replaceFilesTogether(std::initializer_list<FileContent> files) {
+  std::vector<std::string> temps;
   std::string failed;
   for (const FileContent& file : files) {
-    bool created = false;
-    if (const int error = writeAndClose(tempPathOf(file.path), file.text, true, created);
-        error != 0) {
-      failed = created
-                   ? file.path.string() + ": cannot write: " + std::strerror(error)
-                   : tempPathOf(file.path).string() + ": cannot create: " + std::strerror(error);
+    TempBeside temp = writeBeside(file.path, file.text, true);
+    if (!temp.failed.empty()) {
+      failed = std::move(temp.failed);
       break;
     }
+    temps.push_back(std::move(temp.name));
   }
+  std::size_t renamed = 0;
   for (const FileContent& file : files) {
-    if (failed.empty() && ::rename(tempPathOf(file.path).c_str(), file.path.c_str()) != 0) {
-      const int error = errno;
-      failed = file.path.string() + ": cannot write: " + std::strerror(error);
-    }
-    if (!failed.empty())
-      ::unlink(tempPathOf(file.path).c_str());
+    if (!failed.empty() || renamed == temps.size())
+      break;
+    if (::rename(temps[renamed].c_str(), file.path.c_str()) != 0)
+      failed = file.path.string() + ": cannot write: " + std::strerror(errno);
+    else
+      ++renamed;
   }
-  if (!failed.empty())
+  if (!failed.empty()) {
+    for (std::size_t i = renamed; i < temps.size(); ++i)
+      ::unlink(temps[i].c_str());
     return failed;
+  }
   for (const FileContent& file : files) {
     if (const int sync_error = syncDirectory(file.path.parent_path()); sync_error != 0)
       return file.path.parent_path().string() + ": cannot sync: " + std::strerror(sync_error);
@@ -131,28 +161,19 @@ std::string writeWholeFile(const std::filesystem::path& path, std::string_view d
   const bool exists = ::lstat(path.c_str(), &info) == 0;
   if (exists && !S_ISREG(info.st_mode)) {
     bool created = false;
-    const int error = writeAndClose(path, data, false, created);
+    const int error = writeAndClose(path, data, created);
     if (!created)
       return path.string() + ": cannot create: " + std::strerror(error);
     if (error != 0)
       return path.string() + ": cannot write: " + std::strerror(error);
     return {};
   }
-  // A name of its own (mkstemp), so that no file already there is truncated or followed.
-  std::string temp = path.string() + ".tmp.XXXXXX";
-  const int fd = ::mkstemp(temp.data());
-  if (fd < 0)
-    return path.string() + ": cannot create: " + std::strerror(errno);
-  int error = ::fchmod(fd, 0644) == 0 ? 0 : errno;
-  if (error == 0)
-    error = writeFully(fd, data.data(), data.size());
-  // close() reports what a network or full file system deferred.
-  if (::close(fd) != 0 && error == 0)
-    error = errno;
-  if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0)
-    error = errno;
-  if (error != 0) {
-    ::unlink(temp.c_str());
+  TempBeside temp = writeBeside(path, data, false);
+  if (!temp.failed.empty())
+    return temp.failed;
+  if (::rename(temp.name.c_str(), path.c_str()) != 0) {
+    const int error = errno;
+    ::unlink(temp.name.c_str());
     return path.string() + ": cannot write: " + std::strerror(error);
   }
   return {};

@@ -95,7 +95,7 @@ TEST(DurableFileTest, ReplaceAndAppendWriteWhatTheySayAndNameThePathInErrors) {
   EXPECT_EQ(read(path), "one\n");
   EXPECT_EQ(replaceFileAtomically(path, "two\n"), "");
   EXPECT_EQ(read(path), "two\n");
-  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  EXPECT_EQ(testing_support::tempFilesBeside(path), 0u);
   EXPECT_EQ(appendDurably(path, "three\n"), "");
   EXPECT_EQ(appendDurably(dir / "new.txt", "first\n"), "");
   EXPECT_EQ(read(path), "two\nthree\n");
@@ -213,6 +213,27 @@ TEST(DurableFileTest, AnAppenderKilledMidWriteLeavesEveryEarlierRecordWhole) {
     }
     EXPECT_GE(index, 4) << "the child had appended at least four records before the kill";
   }
+}
+
+// The temporary file has a name of its own: a file already called PATH.tmp was truncated, and a
+// link there was followed to its target, by the fixed name an earlier version used.
+TEST(DurableFileTest, AReplaceLeavesAFileOrALinkNamedLikeItsTemporaryFileAlone) {
+  const ScopedTempDir dir("durable_replace_names");
+  const fs::path path = dir / "session.json";
+  const fs::path other = dir / "other.txt";
+  std::ofstream(other) << "not to be touched";
+  fs::create_symlink(other, path.string() + ".tmp");
+  ASSERT_EQ(replaceFileAtomically(path, "{}\n"), "");
+  EXPECT_EQ(read(path), "{}\n");
+  EXPECT_EQ(read(other), "not to be touched");
+  EXPECT_TRUE(fs::is_symlink(path.string() + ".tmp"));
+  fs::remove(path.string() + ".tmp");
+  std::ofstream(path.string() + ".tmp") << "someone else's";
+  ASSERT_EQ(replaceFilesTogether({{path, "[]\n"}, {other, "new"}}), "");
+  EXPECT_EQ(read(path), "[]\n");
+  EXPECT_EQ(read(other), "new");
+  EXPECT_EQ(read(path.string() + ".tmp"), "someone else's");
+  EXPECT_EQ(testing_support::tempFilesBeside(other), 0u);
 }
 
 TEST(DurableFileTest, AReplacerKilledMidWriteLeavesTheOldOrTheNewFileNeverAMix) {

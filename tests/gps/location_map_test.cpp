@@ -7,6 +7,8 @@
 #include <fstream>
 #include <string>
 
+#include "support/temp_dir.h"
+
 namespace fieldrig::gps {
 namespace {
 
@@ -246,7 +248,7 @@ TEST_F(LocationMapFileTest, SaveAndLoadOnDisk) {
   const auto path = directory_ / "map.csv";
   auto saved = original.save(path);
   ASSERT_TRUE(saved.ok()) << saved.error().message;
-  EXPECT_FALSE(std::filesystem::exists(directory_ / "map.csv.tmp"));
+  EXPECT_EQ(testing_support::tempFilesBeside(path), 0u);
   auto loaded = LocationMap::load(path);
   ASSERT_TRUE(loaded.ok()) << loaded.error().message;
   expectSameLocations(original, *loaded);

@@ -34,4 +34,15 @@ class ScopedTempDir {
   std::filesystem::path path_;
 };
 
+// The temporary files the durable writers (core/durable_file.h) leave beside `path`: names
+// starting with "FILE.tmp" in its folder. A writer that finished, or failed cleanly, leaves none.
+inline std::size_t tempFilesBeside(const std::filesystem::path& path) {
+  const std::string prefix = path.filename().string() + ".tmp";
+  std::size_t count = 0;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(path.parent_path(), ec))
+    count += entry.path().filename().string().starts_with(prefix) ? 1 : 0;
+  return count;
+}
+
 }  // namespace fieldrig::testing_support

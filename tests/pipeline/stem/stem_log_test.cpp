@@ -153,7 +153,7 @@ TEST(StemLog, RemovingTheLastRowTakesOnlyThatSessionsLastRow) {
   std::string header;
   std::getline(in, header);
   EXPECT_EQ(header, csvHeader());
-  EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp")) << "the temporary file is left";
+  EXPECT_EQ(testing_support::tempFilesBeside(file), 0u) << "the temporary file is left";
 
   ASSERT_TRUE(removeLastMeasurement(file, "north")->has_value());
   auto none = removeLastMeasurement(file, "north");

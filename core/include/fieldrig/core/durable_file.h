@@ -21,8 +21,9 @@ int syncDirectory(const std::filesystem::path& dir);
 // Reads a whole file; nullopt with `error` set ("PATH: reason") when it cannot.
 std::optional<std::string> readWholeFile(const std::filesystem::path& path, std::string& error);
 
-// Writes `text` to `path` through a temporary file, fsync and rename, so that a reader sees the
-// old or the new content, never a mix. Empty on success, else "PATH: reason".
+// Writes `text` to `path` through a temporary file beside it (PATH.tmp.XXXXXX, a name of its own),
+// fsync and rename, so that a reader sees the old or the new content, never a mix. Empty on
+// success, else "PATH: reason".
 std::string replaceFileAtomically(const std::filesystem::path& path, std::string_view text);
 
 // Files that belong together (a calibration's two): every temporary file is written and synced
