@@ -28,6 +28,11 @@ void removeResults(const std::filesystem::path& dir) {
     std::filesystem::remove(file, ec);
 }
 
+double mapToFixMetres(const gps::ImagingLocation& location, const core::GpsFix& fix) {
+  return gps::geodesicDistanceMetres({location.latitude_deg, location.longitude_deg},
+                                     {fix.latitude_deg, fix.longitude_deg});
+}
+
 void placePlot(PlotIdentity& identity, const std::optional<core::GpsFix>& fix,
                const gps::LocationMap* map) {
   identity.position.reset();
@@ -37,9 +42,7 @@ void placePlot(PlotIdentity& identity, const std::optional<core::GpsFix>& fix,
   if (location) {
     identity.position = std::pair{location->latitude_deg, location->longitude_deg};
     if (fix) {
-      const double metres =
-          gps::geodesicDistanceMetres({location->latitude_deg, location->longitude_deg},
-                                      {fix->latitude_deg, fix->longitude_deg});
+      const double metres = mapToFixMetres(*location, *fix);
       if (metres > kMapToFixToleranceM) {
         identity.placement_problem = "map location " + *id + " is " +
                                      std::to_string(static_cast<long long>(std::lround(metres))) +

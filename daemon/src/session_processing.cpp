@@ -7,7 +7,6 @@
 #include "fieldrig/core/durable_file.h"
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/head_frames.h"
-#include "fieldrig/gps/local_frame.h"
 
 namespace fieldrig::daemon {
 
@@ -101,9 +100,7 @@ core::Result<void> checkMapMatchesSession(const recording::SessionReader& reader
       ++near;  // nothing to hold it against: taken as the map says
       continue;
     }
-    const double metres =
-        gps::geodesicDistanceMetres({location->latitude_deg, location->longitude_deg},
-                                    {set.fix->latitude_deg, set.fix->longitude_deg});
+    const double metres = mapToFixMetres(*location, *set.fix);
     if (metres <= kMapToFixToleranceM) {
       ++near;
     } else if (!first_far) {

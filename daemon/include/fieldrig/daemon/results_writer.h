@@ -47,6 +47,11 @@ struct PlotIdentity {
 // metres means a map of another field, or a fix that jumped.
 inline constexpr double kMapToFixToleranceM = 10.0;
 
+// The geodesic distance, m, between a map location and the fix at its trigger: what is held
+// against kMapToFixToleranceM, for one plot (placePlot) and for a whole session's map
+// (session_processing.h: checkMapMatchesSession).
+double mapToFixMetres(const gps::ImagingLocation& location, const core::GpsFix& fix);
+
 // Sets identity.position: the map location of identity.location_id when the map knows it, else
 // the fix at the trigger (none without either). With a map, a location it lacks, or one farther
 // than kMapToFixToleranceM from the fix, is said in identity.placement_problem: a map of another
