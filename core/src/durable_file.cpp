@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <random>
 #include <vector>
 
 namespace fieldrig::core {
@@ -93,20 +94,38 @@ struct TempBeside {
   std::string failed;  // "PATH: reason", or empty
 };
 
-// Writes `data` into a file beside `path` under a name of its own (mkstemp), so that no file
-// already there is truncated or followed through a link, and two writers never share one; synced
-// when `sync`.
+// Opens a new file beside `path` under a name of its own (PATH.tmp. and six random characters),
+// as mkstemp does, but with the mode a plain open gives, 0644 less the umask (mkstemp's 0600 and a
+// fixed chmod would both ignore the crew's umask), and O_CLOEXEC and O_NOFOLLOW. The fd, or -1
+// with errno set.
+int openNewBeside(const std::filesystem::path& path, std::string& name) {
+  static constexpr char kLetters[] =
+      "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+  thread_local std::mt19937_64 random{std::random_device{}() ^
+                                      static_cast<std::uint64_t>(::getpid())};
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    name = path.string() + ".tmp.";
+    for (int i = 0; i < 6; ++i)
+      name += kLetters[random() % (sizeof(kLetters) - 1)];
+    const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd >= 0 || errno != EEXIST)
+      return fd;
+  }
+  return -1;  // errno is EEXIST
+}
+
+// Writes `data` into a file beside `path` under a name of its own, so that no file already there
+// is truncated or followed through a link, and two writers never share one; synced when `sync`.
 TempBeside writeBeside(const std::filesystem::path& path, std::string_view data, bool sync) {
-  TempBeside temp{path.string() + ".tmp.XXXXXX", {}};
-  const int fd = ::mkstemp(temp.name.data());
+  TempBeside temp;
+  const int fd = openNewBeside(path, temp.name);
   if (fd < 0) {
-    temp.failed = path.string() + ": cannot create: " + std::strerror(errno);
+    const int error = errno;
+    temp.failed = path.string() + ": cannot create: " + std::strerror(error);
     temp.name.clear();
     return temp;
   }
-  int error = ::fchmod(fd, 0644) == 0 ? 0 : errno;
-  if (error == 0)
-    error = writeFully(fd, data.data(), data.size());
+  int error = writeFully(fd, data.data(), data.size());
   if (error == 0 && sync && ::fsync(fd) != 0)
     error = errno;
   // close() reports what a network or full file system deferred.
@@ -137,10 +156,12 @@ std::string replaceFilesTogether(std::initializer_list<FileContent> files) {
   for (const FileContent& file : files) {
     if (!failed.empty() || renamed == temps.size())
       break;
-    if (::rename(temps[renamed].c_str(), file.path.c_str()) != 0)
-      failed = file.path.string() + ": cannot write: " + std::strerror(errno);
-    else
+    if (::rename(temps[renamed].c_str(), file.path.c_str()) != 0) {
+      const int error = errno;
+      failed = file.path.string() + ": cannot write: " + std::strerror(error);
+    } else {
       ++renamed;
+    }
   }
   if (!failed.empty()) {
     for (std::size_t i = renamed; i < temps.size(); ++i)

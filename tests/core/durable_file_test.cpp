@@ -5,6 +5,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -233,7 +234,46 @@ TEST(DurableFileTest, AReplaceLeavesAFileOrALinkNamedLikeItsTemporaryFileAlone) 
   EXPECT_EQ(read(path), "[]\n");
   EXPECT_EQ(read(other), "new");
   EXPECT_EQ(read(path.string() + ".tmp"), "someone else's");
+  EXPECT_EQ(testing_support::tempFilesBeside(path), 1u) << "only the decoy PATH.tmp is there";
   EXPECT_EQ(testing_support::tempFilesBeside(other), 0u);
+}
+
+// A rename that fails after another went through (a target that became a folder): the first file
+// is new, the one that failed is named, and no temporary file of either is left.
+TEST(DurableFileTest, FilesReplacedTogetherNameARenameThatFailsAndLeaveNoTemporaryFile) {
+  const ScopedTempDir dir("durable_together_rename");
+  const fs::path first = dir / "intrinsics.yml";
+  const fs::path second = dir / "extrinsics.yml";
+  fs::create_directories(second);
+  const std::string failed = replaceFilesTogether({{first, "new first"}, {second, "new second"}});
+  EXPECT_EQ(failed.rfind(second.string() + ": cannot write: ", 0), 0u) << failed;
+  EXPECT_EQ(read(first), "new first");
+  EXPECT_TRUE(fs::is_directory(second));
+  EXPECT_EQ(testing_support::tempFilesBeside(first), 0u);
+  EXPECT_EQ(testing_support::tempFilesBeside(second), 0u);
+}
+
+// The new file takes the mode a plain open would give, 0644 less the umask: a crew's umask 077
+// keeps its session records private, as it did before the temporary files had names of their own.
+TEST(DurableFileTest, AReplacedFileTakesTheUmasksMode) {
+  const ScopedTempDir dir("durable_umask");
+  const mode_t saved = ::umask(077);
+  const std::string replaced = replaceFileAtomically(dir / "session.json", "{}\n");
+  const std::string whole = writeWholeFile(dir / "cloud.ply", "ply");
+  ::umask(022);
+  const std::string replaced_022 = replaceFileAtomically(dir / "plots.jsonl", "{}\n");
+  ::umask(saved);
+  ASSERT_EQ(replaced, "");
+  ASSERT_EQ(whole, "");
+  ASSERT_EQ(replaced_022, "");
+  const auto mode = [](const fs::path& p) {
+    struct stat info {};
+    EXPECT_EQ(::stat(p.c_str(), &info), 0) << p;
+    return info.st_mode & 0777;
+  };
+  EXPECT_EQ(mode(dir / "session.json"), 0600U);
+  EXPECT_EQ(mode(dir / "cloud.ply"), 0600U);
+  EXPECT_EQ(mode(dir / "plots.jsonl"), 0644U);
 }
 
 TEST(DurableFileTest, AReplacerKilledMidWriteLeavesTheOldOrTheNewFileNeverAMix) {

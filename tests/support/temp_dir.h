@@ -42,6 +42,8 @@ inline std::size_t tempFilesBeside(const std::filesystem::path& path) {
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(path.parent_path(), ec))
     count += entry.path().filename().string().starts_with(prefix) ? 1 : 0;
+  if (ec)  // a folder that cannot be listed must not pass for one without temporary files
+    ADD_FAILURE() << path.parent_path() << ": cannot list: " << ec.message();
   return count;
 }
 
