@@ -84,7 +84,10 @@ TEST(RunCommandLine, AnUnknownLogLevelIsRefused) {
   EXPECT_EQ(loud.exit_code, kExitBadInput);
   EXPECT_EQ(loud.err.rfind("fieldrig sim drive: --log-level: loud not in", 0), 0u) << loud.err;
   EXPECT_EQ(runWith({"--log-level", "debug", "sim", "drive"}).exit_code, kExitOk);
-  EXPECT_EQ(runWith({"--log-level", "", "sim", "drive"}).exit_code, kExitBadInput);
+  const Outcome empty = runWith({"--log-level", "", "sim", "drive"});
+  EXPECT_EQ(empty.exit_code, kExitBadInput);
+  EXPECT_EQ(empty.err.rfind("fieldrig sim drive: --log-level: must not be empty", 0), 0u)
+      << empty.err;
 }
 
 TEST(RunCommandLine, AnOptionCli11RefusesIsOneLineNamingTheCommand) {

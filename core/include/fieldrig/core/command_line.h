@@ -13,15 +13,18 @@ namespace fieldrig::core {
 // emptiness to mean "not given", so an empty value would silently act as no option at all
 // (`--shard ''` processed every set in every array task; `fieldrigd replay --recording ''` wrote
 // into the configuration's folder).
-inline void refuseEmptyValues(CLI::App& app) {
-  const CLI::Validator non_empty(
+inline CLI::Validator nonEmpty() {
+  return CLI::Validator(
       [](std::string& input) {
         return input.empty() ? std::string("must not be empty") : std::string{};
       },
       "");
+}
+
+inline void refuseEmptyValues(CLI::App& app) {
   for (CLI::Option* option : app.get_options()) {
     if (option->get_type_size_max() > 0)
-      option->check(non_empty);
+      option->check(nonEmpty());
   }
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
     refuseEmptyValues(*sub);
@@ -31,7 +34,10 @@ inline void refuseEmptyValues(CLI::App& app) {
 // word as "off", so `--log-level loud` would have silenced the log without a word.
 inline CLI::Option* addLogLevelOption(CLI::App& app, std::string& log_level,
                                       const std::string& description) {
+  // Empty first, so that '' is said as for every other option (CLI11 stops at the first check
+  // that fails).
   return app.add_option("--log-level", log_level, description)
+      ->check(nonEmpty())
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
 }
 
