@@ -2,7 +2,8 @@
 //
 // Besides crashes and sanitizer reports: a line that is refused says why; a set that is read has
 // every frame file inside the session folder (relative, no "..": readers join it to the folder),
-// and what toIndexLine() writes of it reads back into a set that writes the same line again.
+// a fix on Earth (latitude within 90 degrees, longitude within 180), and what toIndexLine() writes
+// of it reads back into a set that writes the same line again.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -93,6 +94,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* bytes, std::size_t siz
           "a frame file outside the session folder was accepted");
   }
   check(std::isfinite(set->skew_us), "a skew that is not finite");
+  if (set->fix) {
+    check(std::isfinite(set->fix->latitude_deg) && std::fabs(set->fix->latitude_deg) <= 90,
+          "a fix's latitude out of range");
+    check(std::isfinite(set->fix->longitude_deg) && std::fabs(set->fix->longitude_deg) <= 180,
+          "a fix's longitude out of range");
+  }
 
   const std::string written = toIndexLine(*set);
   check(written.find('\n') == std::string::npos, "an index line with a line break in it");
