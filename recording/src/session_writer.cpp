@@ -3,6 +3,7 @@
 #include <dirent.h>
 #include <fcntl.h>
 #include <spdlog/spdlog.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -58,6 +59,33 @@ core::Result<Json> newSessionJson(const SessionInfo& info) {
 
 // Removes what a crashed run left in frames/: temporary files, and frame files of sets whose
 // index line was never written (their numbers are reused now).
+// A frame file of a later set than the one in flight, or any frame file when there was no index
+// at all, means the index does not hold every set captured (lost, or replaced by another): the
+// reopening is refused naming it, since removing or overwriting those frames would lose them.
+std::string framesBeyondTheIndex(const fs::path& frames_dir, std::uint64_t next_set_index,
+                                 bool index_existed) {
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(frames_dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.ends_with(".tmp"))
+      continue;
+    std::uint64_t number = 0;
+    std::size_t digits = 0;
+    while (digits < name.size() && name[digits] >= '0' && name[digits] <= '9' && digits < 18)
+      number = number * 10 + static_cast<std::uint64_t>(name[digits++] - '0');
+    if (digits == 0)
+      continue;
+    if (!index_existed || number > next_set_index) {
+      return entry.path().string() + ": a frame of set " + std::to_string(number) + ", but " +
+             (index_existed ? "the index ends before set " + std::to_string(next_set_index)
+                            : "there is no " + std::string(kIndexFile)) +
+             ": the index does not hold every captured set (lost or replaced?); nothing is "
+             "changed (restore the index, or record into another folder)";
+    }
+  }
+  return {};
+}
+
 std::uint64_t removeLeftovers(const fs::path& frames_dir, std::uint64_t next_set_index) {
   std::uint64_t removed = 0;
   std::error_code ec;
@@ -175,9 +203,23 @@ core::Result<OpenReport> SessionWriter::open(const fs::path& dir, const SessionI
       return fresh.error();
     session = std::move(fresh.value());
   }
+  const bool index_existed = fs::exists(index_path, ec);
   index_fd_ = ::open(index_path.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (index_fd_ < 0)
     return core::Error{index_path.string() + ": cannot open: " + errnoText(errno)};
+  // One writer at a time: two daemons on one folder interleaved their sets in the index and
+  // overwrote each other's frames. The lock goes with the descriptor (close, or a crash).
+  if (::flock(index_fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int lock_error = errno;
+    close();
+    if (!index_existed)
+      fs::remove(index_path, ec);
+    return core::Error{index_path.string() + ": " +
+                       (lock_error == EWOULDBLOCK
+                            ? std::string("in use by another writer (a second fieldrigd or "
+                                          "fieldrig acquire on this recording folder?)")
+                            : "cannot lock: " + errnoText(lock_error))};
+  }
   const std::optional<std::string> content = detail::readWholeFile(index_path, error);
   if (!content) {
     close();
@@ -201,6 +243,13 @@ core::Result<OpenReport> SessionWriter::open(const fs::path& dir, const SessionI
     }
     spdlog::warn("{}:{}: torn last line ({} bytes) cut away", index_path.string(),
                  report.torn_line->line, report.torn_line->bytes);
+  }
+  if (std::string beyond = framesBeyondTheIndex(frames_dir_, next_set_index_, index_existed);
+      !beyond.empty()) {
+    close();
+    if (!index_existed)
+      fs::remove(index_path, ec);
+    return core::Error{std::move(beyond)};
   }
   // Only once the index is known to be usable, so that a refused reopening changes nothing.
   if (std::string failure = detail::replaceFileAtomically(session_path, session.dump(2) + "\n");

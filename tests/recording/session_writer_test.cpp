@@ -339,6 +339,66 @@ TEST(SessionWriterTest, ReopenRemovesWhatACrashedRunLeftInFrames) {
   EXPECT_EQ(countFiles(session / "frames"), 12u);
 }
 
+// Two daemons on one recording folder interleaved their sets in the index (0,1,0,2,…) and
+// overwrote each other's frames; the second writer is refused while the first holds the folder.
+TEST(SessionWriterTest, ASecondWriterOnTheFolderIsRefusedWhileTheFirstHoldsIt) {
+  ScopedTempDir tmp("rec_two_writers");
+  const fs::path session = tmp / "s";
+  SyntheticRig rig(kWidth, kHeight);
+  SessionWriter first;
+  ASSERT_TRUE(first.open(session, SessionInfo{}));
+  writeSets(first, rig, 0, 1);
+  {
+    SessionWriter second;
+    const core::Result<OpenReport> refused = second.open(session, SessionInfo{});
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("index.jsonl: in use by another writer"),
+              std::string::npos)
+        << refused.error().message;
+  }
+  writeSets(first, rig, 1, 1);
+  first.close();
+  SessionWriter after;
+  const core::Result<OpenReport> reopened = after.open(session, SessionInfo{});
+  ASSERT_TRUE(reopened) << reopened.error().message;
+  EXPECT_EQ(reopened->next_set_index, 2u);
+}
+
+// With its index gone (deleted, or a copy without it), a reopening numbered sets from 0 again and
+// removed every captured frame as a "leftover"; stray frames in a new folder went the same way.
+TEST(SessionWriterTest, FramesTheIndexDoesNotHoldAreKeptAndTheOpeningIsRefused) {
+  ScopedTempDir tmp("rec_index_lost");
+  const fs::path session = tmp / "s";
+  SyntheticRig rig(kWidth, kHeight);
+  {
+    SessionWriter writer;
+    ASSERT_TRUE(writer.open(session, SessionInfo{}));
+    writeSets(writer, rig, 0, 3);
+  }
+  const std::size_t frames = countFiles(session / "frames");
+  ASSERT_GT(frames, 0u);
+  fs::remove(session / "index.jsonl");
+  SessionWriter writer;
+  const core::Result<OpenReport> lost = writer.open(session, SessionInfo{});
+  ASSERT_FALSE(lost);
+  EXPECT_NE(lost.error().message.find("there is no index.jsonl"), std::string::npos)
+      << lost.error().message;
+  EXPECT_EQ(countFiles(session / "frames"), frames);
+  EXPECT_FALSE(fs::exists(session / "index.jsonl")) << "a refused opening created the index";
+
+  // An index that ends two sets early (an older copy put back).
+  const fs::path stray = tmp / "stray";
+  fs::create_directories(stray / "frames");
+  fs::copy_file(session / "frames" / "000002_0_bottom_left.pgm",
+                stray / "frames" / "000002_0_bottom_left.pgm");
+  const core::Result<OpenReport> stray_frames = writer.open(stray, SessionInfo{});
+  ASSERT_FALSE(stray_frames);
+  EXPECT_NE(stray_frames.error().message.find("000002_0_bottom_left.pgm: a frame of set 2"),
+            std::string::npos)
+      << stray_frames.error().message;
+  EXPECT_TRUE(fs::exists(stray / "frames" / "000002_0_bottom_left.pgm"));
+}
+
 TEST(SessionWriterTest, WriteWithoutASessionIsRefusedWithoutThrowing) {
   SessionWriter writer;
   SyntheticRig rig(4, 4);
