@@ -155,6 +155,10 @@ core::Result<Image> SessionReader::loadFrame(const IndexedFrame& frame) const {
   return image;
 }
 
+bool SessionReader::pixelsMatchIndex(const IndexedFrame& frame, const Image& image) {
+  return detail::crc32(image.pixels) == frame.crc32;
+}
+
 VerifyReport SessionReader::verify() const {
   VerifyReport report;
   for (const IndexedSet& set : sets_) {

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <numeric>
 
 #include "fieldrig/recording/session_writer.h"
@@ -177,6 +178,34 @@ TEST(SessionReplaySourceErrorsTest, ADamagedFileIsAnErrorAtOpenOrACorruptFrameWh
   ASSERT_FALSE(preloaded.ok());
   EXPECT_NE(preloaded.error().message.find("000000_1_bottom_right"), std::string::npos)
       << preloaded.error().message;
+}
+
+// A frame damaged inside (whole file, pixels that no longer match the index's CRC-32) was
+// replayed as ok, and the new session stored a fresh checksum: the damage was laundered.
+TEST(SessionReplaySourceErrorsTest, PixelsThatDoNotMatchTheIndexAreReplayedAsCorrupt) {
+  const ScopedTempDir dir("replay_source_crc");
+  const auto session = writeSession(dir.path());
+  const auto file = session / recording::frameFileName(0, 1, "bottom_right");
+  {
+    std::fstream pgm(file, std::ios::in | std::ios::out | std::ios::binary);
+    pgm.seekp(-1, std::ios::end);
+    pgm.put('\x7f');
+    ASSERT_TRUE(pgm.good());
+  }
+  const auto pool = core::FramePool::create(2, std::size_t{kReplayWidth} * kReplayHeight).value();
+  for (const std::uint64_t preload_mb : {std::uint64_t{0}, std::uint64_t{64}}) {
+    auto source = SessionReplaySource::open(cameraConfig("1"), 1, session, preload_mb);
+    ASSERT_TRUE(source.ok()) << source.error().message;
+    const Served damaged = serve(**source, *pool, 1, 0);
+    ASSERT_TRUE(damaged.delivered);
+    EXPECT_EQ(damaged.frame.metadata.status, core::FrameStatus::kCorrupt) << preload_mb;
+    std::vector<std::uint8_t> expected = pixelsFrom(100);
+    expected.back() = 0x7f;
+    EXPECT_EQ(damaged.pixels, expected) << "the pixels as they are";
+    const Served whole = serve(**source, *pool, 1, 2);
+    ASSERT_TRUE(whole.delivered);
+    EXPECT_EQ(whole.frame.metadata.status, core::FrameStatus::kOk) << preload_mb;
+  }
 }
 
 TEST(SessionReplaySourceErrorsTest, BadSessionsAreErrorsNamingTheFolderAndWhatIsWrong) {

@@ -68,6 +68,7 @@ core::Result<std::unique_ptr<SessionReplaySource>> SessionReplaySource::open(
       auto image = source->reader_.loadFrame(*entry.frame);
       if (!image)
         return core::Error{where + image.error().message};
+      entry.damaged = !recording::SessionReader::pixelsMatchIndex(*entry.frame, *image);
       entry.pixels = std::move(image->pixels);
     }
   }
@@ -97,10 +98,14 @@ bool SessionReplaySource::fill(const SimTrigger& trigger, core::FramePool& pool,
   // The width × height was checked by open(): the recorded rows are packed like the buffer.
   std::uint8_t* out = frame.buffer.bytes().data();
   const std::size_t bytes = std::size_t{m.width} * m.height;
+  // A frame whose pixels no longer match the CRC-32 recorded with them is replayed as corrupt:
+  // replayed as ok, the new session would store a fresh checksum and hide the damage.
   m.status = recorded->status == recording::FrameStatus::kCorrupt ? core::FrameStatus::kCorrupt
                                                                   : core::FrameStatus::kOk;
   if (preloaded_) {
     std::memcpy(out, entry.pixels.data(), bytes);
+    if (entry.damaged)
+      m.status = core::FrameStatus::kCorrupt;
     return true;
   }
   // Read here, on the worker thread: a large session never has to fit in memory. loadFrame()
@@ -112,6 +117,8 @@ bool SessionReplaySource::fill(const SimTrigger& trigger, core::FramePool& pool,
     return true;
   }
   std::memcpy(out, image->pixels.data(), bytes);
+  if (!recording::SessionReader::pixelsMatchIndex(*recorded, *image))
+    m.status = core::FrameStatus::kCorrupt;
   return true;
 }
 

@@ -78,6 +78,10 @@ class SessionReader {
   // index describes.
   core::Result<Image> loadFrame(const IndexedFrame& frame) const;
 
+  // Whether `image`'s pixels match the CRC-32 the index stored for `frame` (loadFrame checks the
+  // file's shape, not its pixels: a frame damaged inside still loads).
+  static bool pixelsMatchIndex(const IndexedFrame& frame, const Image& image);
+
   // Reads every indexed frame file: present, the size and PGM header the index says, pixels
   // matching the stored CRC-32.
   VerifyReport verify() const;

@@ -50,6 +50,7 @@ class SessionReplaySource final : public FrameSource {
     const recording::IndexedFrame* frame = nullptr;  // into reader_.sets(); null: not in the set
     std::int64_t offset_ns = 0;        // device timestamp after the set's earliest one
     std::vector<std::uint8_t> pixels;  // preloaded; empty when read per trigger
+    bool damaged = false;              // preloaded pixels that do not match the index's CRC-32
   };
 
   explicit SessionReplaySource(recording::SessionReader reader) : reader_(std::move(reader)) {}
