@@ -40,6 +40,7 @@
 #include "fieldrig/gps/serial_trigger_chain.h"
 #include "fieldrig/gps/trigger_replay.h"
 #include "fieldrig/pipeline/plot_processor.h"
+#include "fieldrig/recording/session_reader.h"
 #include "fieldrig/sim/nmea_player.h"
 #include "fieldrig/sim/sim_camera.h"
 #include "fieldrig/stereo/preprocess.h"
@@ -255,6 +256,7 @@ class Daemon {
         !config_.replay.session.empty()) {
       for (auto& camera : acquisition.rig.cameras)
         camera.options["session"] = config_.replay.session.string();
+      warnAboutTheReplayedSession();
     }
     acquisition.session_dir = config_.recording.dir;
     acquisition.writer = config_.recording.writer;
@@ -359,6 +361,29 @@ class Daemon {
   }
 
   // ---- GPS/trigger thread -------------------------------------------------------------------
+
+  // The sim cameras replay the recorded session's sets in order and wrap around when they run
+  // out, so a session with fewer sets than the map has locations gives later plots earlier plots'
+  // frames, and a torn last index line drops a set unseen: both are said before the run.
+  void warnAboutTheReplayedSession() const {
+    const auto replayed = recording::SessionReader::open(config_.replay.session);
+    if (!replayed)
+      return;  // the sim cameras refuse it at start, naming the problem
+    const std::size_t sets = replayed->sets().size();
+    if (const auto& torn = replayed->tornLine()) {
+      spdlog::warn(
+          "replay.session {}: index.jsonl:{}: torn last line ({} bytes) left out: {} sets "
+          "are replayed",
+          config_.replay.session.string(), torn->line, torn->bytes, sets);
+    }
+    if (!map_.empty() && sets < map_.size()) {
+      spdlog::warn(
+          "replay.session {}: {} sets for the map's {} locations: from trigger {} on, "
+          "the sim cameras replay earlier sets' frames again (those plots' traits are "
+          "not their own)",
+          config_.replay.session.string(), sets, map_.size(), sets + 1);
+    }
+  }
 
   void onTrigger(const core::TriggerEvent& event) {
     if (recording_stopped_alarmed_ == false && acquisition_->stats().recording_stopped) {

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include <exception>
+#include <filesystem>
 #include <iostream>
 #include <new>
 #include <string>
@@ -25,6 +26,22 @@ using fieldrig::daemon::kExitBadInput;
 using fieldrig::daemon::kExitInternal;
 using fieldrig::daemon::kExitOk;
 
+// log.file must be a file the log can be opened in: spdlog's exception from a folder there was
+// an internal error (exit 4) naming no key, and --check-config said ok. Empty when it can be.
+std::string logFileProblem(const std::string& config_path, const fieldrig::config::Config& config) {
+  const std::filesystem::path& file = config.log.file;
+  if (file.empty())
+    return {};
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    return config_path + ": log.file: " + file.string() + ": a folder, not a file";
+  const std::filesystem::path folder = file.has_parent_path() ? file.parent_path() : ".";
+  if (!std::filesystem::is_directory(folder, ec))
+    return config_path + ": log.file: " + file.string() + ": its folder " + folder.string() +
+           " does not exist";
+  return {};
+}
+
 // The configuration and the files it names, as the daemon would load them at start.
 int checkConfig(const std::string& path) {
   auto loaded = fieldrig::config::loadConfig(path);
@@ -33,6 +50,10 @@ int checkConfig(const std::string& path) {
     return kExitBadInput;
   }
   const fieldrig::config::Config& config = *loaded;
+  if (const std::string problem = logFileProblem(path, config); !problem.empty()) {
+    std::cerr << "fieldrigd: " << problem << '\n';
+    return kExitBadInput;
+  }
   if (!config.map.empty()) {
     if (auto map = fieldrig::gps::LocationMap::load(config.map); !map) {
       std::cerr << "fieldrigd: " << map.error().message << '\n';
@@ -149,8 +170,17 @@ int runMain(int argc, char** argv, bool& logging_ready) {
   if (realtime)
     config.replay.realtime = true;
   options.print_results = !quiet;
+  if (const std::string problem = logFileProblem(config_path, config); !problem.empty()) {
+    std::cerr << "fieldrigd: " << problem << '\n';
+    return kExitBadInput;
+  }
   options.config = std::move(config);
-  fieldrig::core::setupLogging(options.config.log.level, options.config.log.file.string());
+  try {
+    fieldrig::core::setupLogging(options.config.log.level, options.config.log.file.string());
+  } catch (const std::exception& e) {  // spdlog cannot open the file (permissions, a full disk)
+    std::cerr << "fieldrigd: " << config_path << ": log.file: " << e.what() << '\n';
+    return kExitBadInput;
+  }
   logging_ready = true;
   return fieldrig::daemon::runDaemon(options);
 }

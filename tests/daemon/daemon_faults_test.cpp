@@ -136,6 +136,48 @@ TEST_F(DaemonFaults, AnEmptyOverrideOrAnUnknownLogLevelIsRefusedAndNothingIsWrit
   EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a refused option wrote something";
 }
 
+// spdlog's exception from a folder as the log file was an internal error (exit 4) naming no key,
+// and --check-config said ok.
+TEST_F(DaemonFaults, ALogFileThatIsAFolderIsNamedAndNothingIsWritten) {
+  ScopedTempDir dir("daemon_log_folder");
+  const fs::path config = writeReplayConfig(
+      dir.path(), "run", field_, "", "log:\n  level: info\n  file: " + dir.path().string() + "\n");
+  const auto run = runDaemon({"replay", "--config", config.string()}, dir.path());
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.err.find("log.file: " + dir.path().string() + ": a folder, not a file"),
+            std::string::npos)
+      << run.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a bad log file wrote something";
+  const auto check = runDaemon({"--check-config", config.string()}, dir.path());
+  EXPECT_EQ(check.exit_code, 2);
+  EXPECT_NE(check.err.find("log.file"), std::string::npos) << check.err;
+}
+
+// The sim cameras wrap around to the first set when the replayed session runs out: a torn last
+// index line gave the last plot the first plot's frames and traits, with exit 0 and no word.
+TEST_F(DaemonFaults, AReplayedSessionWithATornLastLineIsSaidAndSoAreTheWrappedPlots) {
+  ScopedTempDir dir("daemon_torn_source");
+  const fs::path source = field_ / "source-session";
+  const fs::path copy = dir.path() / "source";
+  fs::create_directories(copy / "frames");
+  fs::copy_file(source / "session.json", copy / "session.json");
+  for (const fs::directory_entry& entry : fs::directory_iterator(source / "frames"))
+    fs::create_symlink(entry.path(), copy / "frames" / entry.path().filename());
+  std::string index = readWholeFile(source / "index.jsonl");
+  const std::size_t last_line = index.rfind('\n', index.size() - 2) + 1;
+  index.resize(last_line + (index.size() - last_line) / 2);
+  std::ofstream(copy / "index.jsonl") << index;
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  const auto run =
+      runDaemon({"replay", "--config", config.string(), "--session", copy.string(), "--no-status"},
+                dir.path());
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("index.jsonl:"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("torn last line"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("sim cameras replay earlier sets' frames again"), std::string::npos)
+      << run.err;
+}
+
 // Cameras for a head the calibration does not have, and none for one it has: every plot went
 // without that head, with exit 0 and an --check-config that said ok.
 TEST_F(DaemonFaults, ACalibratedHeadWithoutCamerasIsNamedAndNothingIsWritten) {
