@@ -360,8 +360,6 @@ class Daemon {
     return config_.source.empty() ? std::string("configuration") : config_.source.string();
   }
 
-  // ---- GPS/trigger thread -------------------------------------------------------------------
-
   // The sim cameras replay the recorded session's sets in order and wrap around when they run
   // out, so a session with fewer sets than the map has locations gives later plots earlier plots'
   // frames, and a torn last index line drops a set unseen: both are said before the run.
@@ -384,6 +382,8 @@ class Daemon {
           config_.replay.session.string(), sets, map_.size(), sets + 1);
     }
   }
+
+  // ---- GPS/trigger thread -------------------------------------------------------------------
 
   void onTrigger(const core::TriggerEvent& event) {
     if (recording_stopped_alarmed_ == false && acquisition_->stats().recording_stopped) {

@@ -9,6 +9,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <optional>
 
 #include "file_util.h"
 
@@ -57,8 +58,18 @@ core::Result<Json> newSessionJson(const SessionInfo& info) {
   return out;
 }
 
-// Removes what a crashed run left in frames/: temporary files, and frame files of sets whose
-// index line was never written (their numbers are reused now).
+// The set number a frame file's name starts with (frameFileName: "000012_3_middle_right.pgm"), or
+// none for a name without leading digits. At most 18 digits are read, so that it cannot overflow.
+std::optional<std::uint64_t> setNumberOf(const std::string& name) {
+  std::uint64_t number = 0;
+  std::size_t digits = 0;
+  while (digits < name.size() && digits < 18 && name[digits] >= '0' && name[digits] <= '9')
+    number = number * 10 + static_cast<std::uint64_t>(name[digits++] - '0');
+  if (digits == 0)
+    return std::nullopt;
+  return number;
+}
+
 // A frame file of a later set than the one in flight, or any frame file when there was no index
 // at all, means the index does not hold every set captured (lost, or replaced by another): the
 // reopening is refused naming it, since removing or overwriting those frames would lose them.
@@ -67,16 +78,11 @@ std::string framesBeyondTheIndex(const fs::path& frames_dir, std::uint64_t next_
   std::error_code ec;
   for (const fs::directory_entry& entry : fs::directory_iterator(frames_dir, ec)) {
     const std::string name = entry.path().filename().string();
-    if (name.ends_with(".tmp"))
+    const std::optional<std::uint64_t> number = setNumberOf(name);
+    if (name.ends_with(".tmp") || !number)
       continue;
-    std::uint64_t number = 0;
-    std::size_t digits = 0;
-    while (digits < name.size() && name[digits] >= '0' && name[digits] <= '9' && digits < 18)
-      number = number * 10 + static_cast<std::uint64_t>(name[digits++] - '0');
-    if (digits == 0)
-      continue;
-    if (!index_existed || number > next_set_index) {
-      return entry.path().string() + ": a frame of set " + std::to_string(number) + ", but " +
+    if (!index_existed || *number > next_set_index) {
+      return entry.path().string() + ": a frame of set " + std::to_string(*number) + ", but " +
              (index_existed ? "the index ends before set " + std::to_string(next_set_index)
                             : "there is no " + std::string(kIndexFile)) +
              ": the index does not hold every captured set (lost or replaced?); nothing is "
@@ -86,19 +92,15 @@ std::string framesBeyondTheIndex(const fs::path& frames_dir, std::uint64_t next_
   return {};
 }
 
+// Removes what a crashed run left in frames/: temporary files, and frame files of sets whose
+// index line was never written (their numbers are reused now).
 std::uint64_t removeLeftovers(const fs::path& frames_dir, std::uint64_t next_set_index) {
   std::uint64_t removed = 0;
   std::error_code ec;
   for (const fs::directory_entry& entry : fs::directory_iterator(frames_dir, ec)) {
     const std::string name = entry.path().filename().string();
-    bool leftover = name.ends_with(".tmp");
-    if (!leftover) {
-      std::uint64_t number = 0;
-      std::size_t digits = 0;
-      while (digits < name.size() && name[digits] >= '0' && name[digits] <= '9')
-        number = number * 10 + static_cast<std::uint64_t>(name[digits++] - '0');
-      leftover = digits > 0 && number >= next_set_index;
-    }
+    const std::optional<std::uint64_t> number = setNumberOf(name);
+    const bool leftover = name.ends_with(".tmp") || (number && *number >= next_set_index);
     if (leftover && fs::remove(entry.path(), ec))
       ++removed;
   }
