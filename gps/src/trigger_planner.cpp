@@ -1,5 +1,7 @@
 #include "fieldrig/gps/trigger_planner.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/box.hpp>
@@ -26,6 +28,11 @@ constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
 constexpr std::size_t kMinFitSamples = 3;
 // How far back along the track a location passed without a plan is still reported missed.
 constexpr double kMaxMissedSearchM = 30.0;
+// No vehicle in a field moves faster (54 km/h); a track further from the last plan than this
+// speed allows, plus a margin for the filter restarting on noisy fixes, is a jump of the
+// receiver's solution, not travel.
+constexpr double kMaxVehicleSpeedMps = 15.0;
+constexpr double kJumpMarginM = 2.0;
 // Fixes this far back in time are duplicates or stragglers; further back is a jump in time.
 constexpr double kMaxBackwardStepS = 2.0;
 // A position this many innovation standard deviations (squared, two axes) from the filter's
@@ -276,6 +283,7 @@ struct TriggerPlanner::State {
   MotionFilter filter;  // references `options`: State is never copied or moved
   std::optional<Track> track;
   std::optional<EnuPoint> last_planned_position;  // the track's position at the last plan
+  double last_planned_t = 0;                      // and its time (Sample::t)
   std::vector<Plan> plans;                        // sorted by time
   std::optional<core::UtcTime> last_trigger_time;
   std::uint64_t next_trigger_id = 1;
@@ -456,7 +464,17 @@ std::string_view toString(MotionModel model) {
 }
 
 std::string_view toString(AlarmKind kind) {
-  return kind == AlarmKind::kTooFast ? "too_fast" : "missed";
+  switch (kind) {
+    case AlarmKind::kTooFast:
+      return "too_fast";
+    case AlarmKind::kMissed:
+      return "missed";
+    case AlarmKind::kPositionJump:
+      return "position_jump";
+    case AlarmKind::kTimeJump:
+      return "time_jump";
+  }
+  return "unknown";
 }
 
 core::Result<TriggerPlanner> TriggerPlanner::create(const LocationMap& map,
@@ -499,6 +517,8 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
       // The epoch's other sentence vetoes it (RMC status V or GGA quality 0 after a valid
       // partner): what was planned from its first half must not fire.
       ++s.stats.fixes_invalid;
+      if (s.last_valid_fix && s.last_valid_fix->time == fix.time && s.stats.valid_epochs > 0)
+        --s.stats.valid_epochs;  // its first half was counted valid
       s.restartTrack();
       return;
     }
@@ -509,6 +529,11 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
     // A jump back in time (a receiver glitch with a future date before, a day boundary the
     // date could not follow): start over rather than wait for time to catch up.
     ++s.stats.time_jumps;
+    s.alarms.push_back(
+        {AlarmKind::kTimeJump, "", fix.time,
+         fmt::format("GPS time went back by {:.1f} s (a receiver glitch or a day boundary): the "
+                     "track restarts from this fix",
+                     core::toSeconds(*s.last_fix_time - fix.time))});
     s.restartTrack();
     s.origin = fix.time;
     s.last_planned_position.reset();
@@ -522,6 +547,7 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
     return;
   }
   s.last_valid_fix = fix;
+  ++s.stats.valid_epochs;
   const double t = s.seconds(fix.time);
   if (!s.samples.empty() && t - s.samples.back().t > s.options.max_fix_gap_s)
     s.restartTrack();
@@ -549,12 +575,24 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
   // away does not blame plots that were never on this pass.
   double unplanned_distance = 0;
   if (s.last_planned_position) {
-    unplanned_distance =
-        std::min(kMaxMissedSearchM, std::hypot(s.track->east - s.last_planned_position->east_m,
-                                               s.track->north - s.last_planned_position->north_m));
+    const double step = std::hypot(s.track->east - s.last_planned_position->east_m,
+                                   s.track->north - s.last_planned_position->north_m);
+    const double elapsed = s.track->t - s.last_planned_t;
+    if (step > kMaxVehicleSpeedMps * elapsed + kJumpMarginM) {
+      // Out to a far-away solution and back again would otherwise blame every location behind
+      // the return (already triggered, and re-armed while the position was away) as missed.
+      ++s.stats.position_jumps;
+      s.alarms.push_back({AlarmKind::kPositionJump, "", fix.time,
+                          fmt::format("position moved {:.0f} m in {:.1f} s (a receiver glitch?): "
+                                      "locations in between are not judged",
+                                      step, elapsed)});
+    } else {
+      unplanned_distance = std::min(kMaxMissedSearchM, step);
+    }
   }
   s.plan(now, unplanned_distance);
   s.last_planned_position = EnuPoint{s.track->east, s.track->north};
+  s.last_planned_t = s.track->t;
   // Re-armed only after planning, so that a location fired just before a gap is not taken for
   // one passed during it.
   s.rearm(position);

@@ -63,9 +63,16 @@ core::Result<ReplaySummary> replayTriggers(std::istream& nmea, const LocationMap
       NmeaParserOptions{.max_line_length = NmeaParser::kDefaultMaxLineLength,
                         .comment_lines = true});
 
+  // Whatever has arrived is parsed at once: a pipe fed as the drive goes (a logger, `<(…)`) is
+  // not held back until a whole chunk is there, as read() of a full chunk would.
   std::array<char, 65536> chunk{};
-  while (nmea.read(chunk.data(), chunk.size()) || nmea.gcount() > 0) {
-    parser.feed(std::string_view(chunk.data(), static_cast<std::size_t>(nmea.gcount())));
+  while (nmea.peek() != std::istream::traits_type::eof()) {
+    std::streamsize got = nmea.readsome(chunk.data(), chunk.size());
+    if (got == 0) {  // a stream without a buffer says nothing is available: one byte at a time
+      nmea.read(chunk.data(), 1);
+      got = nmea.gcount();
+    }
+    parser.feed(std::string_view(chunk.data(), static_cast<std::size_t>(got)));
   }
   parser.flush();
   // At the end of the capture the live daemon's timer would still fire what was planned.

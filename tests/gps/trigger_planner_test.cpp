@@ -240,6 +240,8 @@ TEST(TriggerPlannerTest, SameEpochVetoDropsThePlan) {
       events.push_back(e);
   }
   EXPECT_TRUE(events.empty());
+  // 101 epochs, 11 of them vetoed: a vetoed epoch's valid first half is not a valid epoch.
+  EXPECT_EQ(planner.stats().valid_epochs, 90u);
 }
 
 TEST(TriggerPlannerTest, RecoversFromAJumpBackInTime) {
@@ -251,6 +253,56 @@ TEST(TriggerPlannerTest, RecoversFromAJumpBackInTime) {
   const auto events = drive(field, planner, Drive{});
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(planner.stats().time_jumps, 1u);
+  // Said, not only counted: a crew sees why the track started over.
+  const auto alarms = planner.takeAlarms();
+  ASSERT_EQ(alarms.size(), 1u);
+  EXPECT_EQ(alarms[0].kind, AlarmKind::kTimeJump);
+  EXPECT_EQ(toString(alarms[0].kind), "time_jump");
+}
+
+TEST(TriggerPlannerTest, APositionJumpAwayAndBackBlamesNoTriggeredLocation) {
+  Field field;
+  for (int i = 0; i < 5; ++i)
+    field.addLocation("P" + std::to_string(i), 0.0, 1.3 + 3.7 * i);
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
+  // North at 2 m/s from -10 m; for 0.8 s (north 6.0 to 7.6 m, after P0 and P1 fired, before P2)
+  // the receiver reports a solution 2 km east, moving on as the tractor does.
+  std::vector<core::TriggerEvent> events;
+  for (int k = 0; k <= 150; ++k) {
+    const core::UtcTime t = kStart + k * 100ms;
+    for (auto& e : planner.collectDue(t - 1ns))
+      events.push_back(e);
+    const double north = -10.0 + 0.2 * k;
+    const double east = (k >= 80 && k < 88) ? 2000.0 : 0.0;
+    planner.addFix(field.fixAt(t, east, north), t);
+    for (auto& e : planner.collectDue(t))
+      events.push_back(e);
+  }
+  ASSERT_EQ(events.size(), 5u);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(events[i].location_id, "P" + std::to_string(i));
+  EXPECT_EQ(planner.stats().missed, 0u);
+  const auto alarms = planner.takeAlarms();
+  ASSERT_FALSE(alarms.empty());
+  for (const PlannerAlarm& alarm : alarms) {
+    EXPECT_EQ(alarm.kind, AlarmKind::kPositionJump) << alarm.message;
+    EXPECT_TRUE(alarm.location_id.empty());
+  }
+  EXPECT_EQ(planner.stats().position_jumps, alarms.size());
+}
+
+TEST(TriggerPlannerTest, ALocationPassedDuringAGapAtDrivingSpeedIsStillMissedNotAJump) {
+  Field field;
+  field.addLocation("A", 0.0, 5.0);  // crossed at k = 75
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
+  Drive d;
+  d.speed = 12.0;  // fast, but a speed a vehicle can have: the gap is travel, not a jump
+  d.north_start = -85.0;
+  d.present = [](int k) { return k < 65 || k > 78; };
+  const auto events = drive(field, planner, d);
+  EXPECT_TRUE(events.empty());
+  EXPECT_EQ(planner.stats().missed, 1u);
+  EXPECT_EQ(planner.stats().position_jumps, 0u);
 }
 
 TEST(TriggerPlannerTest, LocationPassedDuringAGapIsReportedMissed) {

@@ -63,6 +63,8 @@ Json summaryJson(const gps::LocationMap& map, const gps::NmeaStats& nmea,
   out["fixes_too_slow"] = s.fixes_too_slow;
   out["track_restarts"] = s.track_restarts;
   out["filter_resets"] = s.filter_resets;
+  out["position_jumps"] = s.position_jumps;
+  out["time_jumps"] = s.time_jumps;
   out["triggers"] = s.triggers;
   out["triggers_late"] = s.triggers_late;
   out["missed"] = s.missed;

@@ -79,8 +79,14 @@ struct TriggerChainOptions {
 enum class AlarmKind {
   kTooFast,  // two triggers closer than min_trigger_interval_s: one was delayed
   kMissed,   // a location was passed without a trigger (gap, invalid or stale fixes)
+  // The position leapt further than a vehicle moves in the time (a receiver glitch): the
+  // locations between the two positions are not blamed as missed, since nothing says they were
+  // passed.
+  kPositionJump,
+  kTimeJump,  // fix time went back by more than 2 s: the track restarts
 };
-std::string_view toString(AlarmKind kind);  // "too_fast", "missed"
+// "too_fast", "missed", "position_jump", "time_jump"
+std::string_view toString(AlarmKind kind);
 
 struct PlannerAlarm {
   AlarmKind kind = AlarmKind::kTooFast;
@@ -91,7 +97,10 @@ struct PlannerAlarm {
 
 struct TriggerStats {
   std::uint64_t fixes = 0;
-  std::uint64_t fixes_invalid = 0;       // RMC status V or GGA quality 0
+  std::uint64_t fixes_invalid = 0;  // RMC status V or GGA quality 0
+  // Epochs with a valid fix, each counted once (not its second sentence) and not when the
+  // epoch's other sentence vetoed it: what the planner had to work with.
+  std::uint64_t valid_epochs = 0;
   std::uint64_t fixes_out_of_order = 0;  // not newer than the previous fix (duplicates of an epoch)
   std::uint64_t time_jumps = 0;          // fix time went back by more than 2 s: track restarted
   std::uint64_t fixes_too_slow = 0;      // below min_speed_mps
@@ -101,7 +110,8 @@ struct TriggerStats {
   std::uint64_t stale_plans_dropped = 0;
   std::uint64_t missed = 0;
   std::uint64_t too_fast = 0;
-  std::uint64_t filter_resets = 0;  // a fix far outside the filter's prediction (a turn, a jump)
+  std::uint64_t filter_resets = 0;   // a fix far outside the filter's prediction (a turn, a jump)
+  std::uint64_t position_jumps = 0;  // see AlarmKind::kPositionJump
   // The planner's own 1-sigma estimate for the latest trigger: of the crossing time, and of the
   // antenna's along-track position at the moment of firing (0 before the first trigger).
   double last_timing_sigma_s = 0;
