@@ -1,5 +1,7 @@
 #include "fieldrig/drivers/rig.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 
 namespace fieldrig::drivers {
@@ -17,15 +19,54 @@ FrameGrouperOptions grouperOptions(const RigOptions& options) {
   grouping.max_waiting_sets = kMaxWaitingSets;
   return grouping;
 }
+std::size_t largestFrame(const RigOptions& options) {
+  std::size_t largest = 0;
+  for (const CameraConfig& c : options.cameras)
+    largest = std::max(largest, std::size_t{c.width} * c.height);
+  return largest;
+}
 }  // namespace
 
-core::Result<std::unique_ptr<Rig>> Rig::create(const RigOptions& options,
-                                               const CameraRegistry& registry) {
+core::Result<void> Rig::checkOptions(const RigOptions& options, const CameraRegistry& registry) {
   if (options.cameras.empty() || options.cameras.size() > core::FrameSet::kMaxCameras) {
     return core::Error{"rig: between 1 and " + std::to_string(core::FrameSet::kMaxCameras) +
                        " cameras are needed, " + std::to_string(options.cameras.size()) +
                        " configured"};
   }
+  const std::vector<std::string> drivers = registry.names();
+  if (std::find(drivers.begin(), drivers.end(), options.driver) == drivers.end()) {
+    // The registry's own words, which list the drivers this build has.
+    if (auto unknown = registry.create(options.driver); !unknown)
+      return unknown.error();
+  }
+  // pool_sets is unbounded in the configuration: refused before the product can wrap.
+  if (options.pool_sets > core::FramePool::kMaxBuffers / options.cameras.size()) {
+    return core::Error{"rig: " + std::to_string(options.pool_sets) + " pool sets of " +
+                       std::to_string(options.cameras.size()) + " cameras exceed the " +
+                       std::to_string(core::FramePool::kMaxBuffers) + " buffers a pool can hold"};
+  }
+  // A pool larger than the machine can never be allocated (or only by swapping the frames out).
+  const std::size_t buffers = options.pool_sets * options.cameras.size();
+  const std::size_t largest = largestFrame(options);
+  const long pages = ::sysconf(_SC_PHYS_PAGES);
+  const long page_bytes = ::sysconf(_SC_PAGE_SIZE);
+  if (pages > 0 && page_bytes > 0 && largest > 0) {
+    const std::size_t memory =
+        static_cast<std::size_t>(pages) * static_cast<std::size_t>(page_bytes);
+    if (buffers > memory / largest) {
+      return core::Error{"rig: " + std::to_string(options.pool_sets) + " pool sets of " +
+                         std::to_string(options.cameras.size()) + " frames of " +
+                         std::to_string(largest) + " bytes need more than this machine's " +
+                         std::to_string(memory >> 20) + " MiB of memory"};
+    }
+  }
+  return {};
+}
+
+core::Result<std::unique_ptr<Rig>> Rig::create(const RigOptions& options,
+                                               const CameraRegistry& registry) {
+  if (auto checked = checkOptions(options, registry); !checked)
+    return checked.error();
   std::vector<std::unique_ptr<Camera>> cameras;
   for (std::size_t i = 0; i < options.cameras.size(); ++i) {
     auto camera = registry.create(options.driver);
@@ -37,17 +78,8 @@ core::Result<std::unique_ptr<Rig>> Rig::create(const RigOptions& options,
     cameras.push_back(std::move(*camera));
   }
   // The pool comes after the cameras, whose own errors explain a bad frame size better.
-  // pool_sets is unbounded in the configuration: refused before the product can wrap.
-  if (options.pool_sets > core::FramePool::kMaxBuffers / options.cameras.size()) {
-    return core::Error{"rig: " + std::to_string(options.pool_sets) + " pool sets of " +
-                       std::to_string(options.cameras.size()) + " cameras exceed the " +
-                       std::to_string(core::FramePool::kMaxBuffers) + " buffers a pool can hold"};
-  }
-  std::size_t largest = 0;
-  for (const CameraConfig& c : options.cameras) {
-    largest = std::max(largest, std::size_t{c.width} * c.height);
-  }
-  auto pool = core::FramePool::create(options.pool_sets * options.cameras.size(), largest);
+  auto pool =
+      core::FramePool::create(options.pool_sets * options.cameras.size(), largestFrame(options));
   if (!pool)
     return core::Error{"rig: " + pool.error().message};
   return std::unique_ptr<Rig>(new Rig(options, std::move(cameras), std::move(*pool)));

@@ -234,6 +234,29 @@ TEST_F(RigTest, PoolErrorsAreRefusedNotThrown) {
       << rig.error().message;
 }
 
+// fieldrigd --check-config runs checkOptions alone: a pool this machine's memory cannot hold is
+// refused there, without allocating, as it is by create().
+TEST_F(RigTest, APoolLargerThanTheMachinesMemoryIsRefusedByTheCheckAlone) {
+  RigOptions options = sixCameras();
+  for (CameraConfig& camera : options.cameras) {
+    camera.width = 16384;  // 256 MiB frames: 10,000 sets of six need 15 TiB
+    camera.height = 16384;
+  }
+  options.pool_sets = 10000;
+  const auto checked = Rig::checkOptions(options, testing_support::camerasWithSim());
+  ASSERT_FALSE(checked.ok());
+  EXPECT_NE(checked.error().message.find("need more than this machine's"), std::string::npos)
+      << checked.error().message;
+  options.pool_sets = 2;
+  for (CameraConfig& camera : options.cameras)
+    camera.width = camera.height = 64;
+  EXPECT_TRUE(Rig::checkOptions(options, testing_support::camerasWithSim()).ok());
+  options.driver = "gige";
+  const auto unknown = Rig::checkOptions(options, testing_support::camerasWithSim());
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().message.find("unknown camera driver 'gige'"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace fieldrig::drivers
 

@@ -56,6 +56,10 @@ class Rig {
  public:
   using SetSink = std::function<void(core::FrameSet&& set)>;
 
+  // What can be refused in the options without creating anything: the camera count, a driver
+  // the registry does not have, a pool beyond what a pool can hold or larger than this machine's
+  // memory. create() runs it first; fieldrigd --check-config runs it alone.
+  static core::Result<void> checkOptions(const RigOptions& options, const CameraRegistry& registry);
   // Allocates the frame pool, creates and configures the cameras; errors name the camera (or the
   // pool) and the problem.
   static core::Result<std::unique_ptr<Rig>> create(const RigOptions& options,
