@@ -55,6 +55,21 @@ TEST_F(SimCliTest, BadRowEndIsAnErrorNamingTheOption) {
   EXPECT_FALSE(fs::exists(dir_ / "drive.nmea"));
 }
 
+// `sim drive` writes its two files once at the end: an output it cannot write is bad input (exit
+// 2, as `map generate`), named, and neither file is left behind.
+TEST_F(SimCliTest, AnOutputThatCannotBeWrittenIsBadInputNamingIt) {
+  const fs::path unwritable = dir_ / "no-such-folder" / "map.csv";
+  const auto run = runFieldrig(
+      {"sim", "drive", "--row-start", "42.0106,-93.7385", "--row-end", "42.0112,-93.7385", "--rows",
+       "2", "--plot-length", "3", "--alley-length", "1", "--row-spacing", "2.286", "--out-nmea",
+       (dir_ / "drive.nmea").string(), "--out-map", unwritable.string()},
+      dir_);
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_NE(run.err.find(unwritable.string()), std::string::npos) << run.err;
+  EXPECT_FALSE(fs::exists(unwritable.parent_path()));
+  EXPECT_FALSE(fs::exists(dir_ / "drive.nmea")) << "a drive was left without its map";
+}
+
 // The speed profile, correlated noise and velocity noise reach the NMEA: RMC speeds breathe
 // around the mean.
 TEST_F(SimCliTest, BreathingDriveReportsTheChangingSpeed) {

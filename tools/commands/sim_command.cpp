@@ -1,17 +1,20 @@
 // `fieldrig sim drive`: a simulated serpentine drive over a field plan, written as the NMEA the
 // auto-guidance receiver would send, with the plan's imaging-location map beside it. Replay-based
 // testing needs no tractor: `fieldrig triggers --map MAP --nmea NMEA` on the two files.
-#include <fstream>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "commands/command_helpers.h"
 #include "commands/field_plan_options.h"
+#include "fieldrig/core/durable_file.h"
 #include "fieldrig/sim/drive_simulator.h"
 
 namespace fieldrig::tools {
 namespace {
+
+namespace fs = std::filesystem;
 
 using Json = nlohmann::ordered_json;
 
@@ -45,15 +48,28 @@ int runDrive(const DriveArgs& args) {
   if (const auto valid = sim::validate(options); !valid)
     return fail(kName, valid.error().message);
   const sim::DriveSimulator drive(*plan, options);
-  std::ofstream nmea(args.out_nmea, std::ios::binary);
-  nmea << drive.nmea();
-  nmea.close();
-  if (!nmea) {
-    std::cerr << kName << "cannot write '" << args.out_nmea << "'\n";
+  // A drive and its map belong together: both are written, or neither (a drive left without its
+  // map, or beside an older one, would replay against the wrong locations). A FIFO, a device or
+  // a link such as /dev/stdout cannot be replaced by a rename: those are written in place.
+  const std::string nmea = drive.nmea();
+  const std::string csv = map->toCsv();
+  auto replaceable = [](const std::string& path) {
+    std::error_code ec;
+    const fs::file_status status = fs::symlink_status(path, ec);
+    return status.type() == fs::file_type::not_found || status.type() == fs::file_type::regular;
+  };
+  std::string failed;
+  if (replaceable(args.out_nmea) && replaceable(args.out_map)) {
+    failed = core::replaceFilesTogether({{args.out_nmea, nmea}, {args.out_map, csv}});
+  } else {
+    failed = core::writeWholeFile(args.out_nmea, nmea);
+    if (failed.empty())
+      failed = core::writeWholeFile(args.out_map, csv);
+  }
+  if (!failed.empty()) {
+    std::cerr << kName << failed << '\n';
     return kExitBadInput;
   }
-  if (const auto saved = map->save(args.out_map); !saved)
-    return fail(kName, saved.error().message);
   Json summary;
   summary["nmea"] = args.out_nmea;
   summary["map"] = args.out_map;
