@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/address.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <fstream>
 #include <iostream>
@@ -24,8 +26,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <thread>
+#include <tuple>
 
 #include "fieldrig/cloud/rig_calibration.h"
+#include "fieldrig/core/interruptible_input.h"
 #include "fieldrig/core/logging.h"
 #include "fieldrig/core/time.h"
 #include "fieldrig/daemon/acquisition.h"
@@ -34,6 +38,7 @@
 #include "fieldrig/daemon/results_writer.h"
 #include "fieldrig/daemon/session_view.h"
 #include "fieldrig/daemon/status_server.h"
+#include "fieldrig/drivers/rig.h"
 #include "fieldrig/gps/local_frame.h"
 #include "fieldrig/gps/location_map.h"
 #include "fieldrig/gps/serial_nmea_source.h"
@@ -142,14 +147,20 @@ class Daemon {
   explicit Daemon(const DaemonOptions& options) : options_(options), config_(options.config) {}
 
   int run() {
+    if (options_.check_only) {
+      const int failed = checkStart();
+      if (failed == kExitOk)
+        std::cout << sourceName() << ": ok" << std::endl;
+      return failed;
+    }
     if (const int failed = prepare(); failed != kExitOk)
       return failed;
     const fs::path& nmea =
         options_.mode == Mode::kReplay ? config_.replay.nmea : fs::path(config_.gps.serial.device);
     std::error_code ec;
     const bool device = fs::is_character_file(nmea, ec);
-    if (options_.mode == Mode::kReplay && !device && !config_.replay.realtime) {
-      runVirtualTime(nmea);
+    if (replaysInVirtualTime()) {
+      runVirtualTime();
     } else {
       runLive(nmea, /*play_file=*/!device);
     }
@@ -157,9 +168,26 @@ class Daemon {
   }
 
  private:
-  // Everything that can fail on bad input, before anything is written: map, calibration,
-  // camera configuration, session folder.
-  int prepare() {
+  // Replay of a file (not a device) in GPS time, as fast as the pipeline takes it.
+  bool replaysInVirtualTime() const {
+    std::error_code ec;
+    return !options_.check_only && options_.mode == Mode::kReplay &&
+           !fs::is_character_file(config_.replay.nmea, ec) && !config_.replay.realtime;
+  }
+
+  // Run mode's and replay mode's own inputs. --check-config knows no mode: it checks the inputs
+  // of each mode that the configuration names.
+  bool checksRunInputs() const {
+    return options_.check_only ? !config_.gps.serial.device.empty() : options_.mode == Mode::kRun;
+  }
+  bool checksReplayInputs() const {
+    return options_.check_only ? !config_.replay.nmea.empty() : options_.mode == Mode::kReplay;
+  }
+
+  // Everything in the configuration that can be refused without writing anything: the map, the
+  // NMEA input, calibration and processing, the folders and the status address. The start runs
+  // it first, and --check-config runs only it, so the two never disagree.
+  int checkStart() {
     if (config_.map.empty()) {
       spdlog::error("{}: map: no imaging-location map configured", sourceName());
       return kExitBadInput;
@@ -184,40 +212,81 @@ class Daemon {
     map_json_ = mapJson();
     max_speed_mps_ = maxSpeedFor(map_, config_.gps.triggers.planner.min_trigger_interval_s);
 
-    if (options_.mode == Mode::kReplay && config_.replay.nmea.empty()) {
+    if (options_.check_only && config_.replay.nmea.empty() && config_.gps.serial.device.empty()) {
+      spdlog::error(
+          "{}: gps.serial.device: neither the receiver's serial port (run) nor "
+          "replay.nmea (replay) is configured",
+          sourceName());
+      return kExitBadInput;
+    }
+    if (options_.mode == Mode::kReplay && config_.replay.nmea.empty() && !options_.check_only) {
       spdlog::error("{}: replay.nmea: replay needs an NMEA file or device", sourceName());
       return kExitBadInput;
     }
-    if (options_.mode == Mode::kRun && config_.gps.serial.device.empty()) {
+    if (options_.mode == Mode::kRun && config_.gps.serial.device.empty() && !options_.check_only) {
       spdlog::error("{}: gps.serial.device: run needs the receiver's serial port", sourceName());
       return kExitBadInput;
     }
-    if (options_.mode == Mode::kReplay) {
+    if (checksReplayInputs()) {
       std::error_code ec;
       if (!fs::exists(config_.replay.nmea, ec)) {
-        spdlog::error("{}: replay.nmea: {}: no such file or device", sourceName(),
+        spdlog::error("{}: {}: no such file or device", whereIs("replay.nmea"),
                       config_.replay.nmea.string());
         return kExitBadInput;
       }
       if (fs::is_directory(config_.replay.nmea, ec)) {
-        spdlog::error("{}: replay.nmea: {}: a folder, not an NMEA file or device", sourceName(),
+        spdlog::error("{}: {}: a folder, not an NMEA file or device", whereIs("replay.nmea"),
                       config_.replay.nmea.string());
         return kExitBadInput;
       }
+      if (!fs::is_character_file(config_.replay.nmea, ec)) {
+        if (replaysInVirtualTime()) {
+          // Opened now, so that an unreadable file is refused before the session is created; a
+          // FIFO opens without waiting for its writer.
+          auto input = core::InterruptibleInput::open(config_.replay.nmea);
+          if (!input) {
+            spdlog::error("{}: {}", whereIs("replay.nmea"), input.error().message);
+            return kExitBadInput;
+          }
+          replay_input_ = std::move(*input);
+        } else if (::access(config_.replay.nmea.c_str(), R_OK) != 0) {
+          // Not opened: a check opening a FIFO would let its writer in and then leave it with a
+          // broken pipe; the real-time player opens the file itself.
+          const int error = errno;
+          spdlog::error("{}: {}: cannot be read: {}", whereIs("replay.nmea"),
+                        config_.replay.nmea.string(), std::strerror(error));
+          return kExitBadInput;
+        }
+      }
     }
     // A device must be a serial port: /dev/null would be opened again and again for ever.
-    const fs::path& nmea_input =
-        options_.mode == Mode::kReplay ? config_.replay.nmea : fs::path(config_.gps.serial.device);
-    if (std::error_code ec; fs::is_character_file(nmea_input, ec)) {
+    for (const auto& [checked, key, nmea_input] :
+         {std::tuple{checksReplayInputs(), "replay.nmea", config_.replay.nmea},
+          std::tuple{checksRunInputs(), "gps.serial.device",
+                     fs::path(config_.gps.serial.device)}}) {
+      std::error_code ec;
+      if (!checked || !fs::is_character_file(nmea_input, ec))
+        continue;
       if (auto serial = gps::checkSerialDevice(nmea_input.string()); !serial) {
-        spdlog::error("{}: {}: {}", sourceName(),
-                      options_.mode == Mode::kReplay ? "replay.nmea" : "gps.serial.device",
-                      serial.error().message);
+        spdlog::error("{}: {}", whereIs(key), serial.error().message);
         return kExitBadInput;
       }
     }
     if (config_.recording.dir.empty()) {
       spdlog::error("{}: recording.dir: no session folder configured", sourceName());
+      return kExitBadInput;
+    }
+    if (std::error_code ec;
+        fs::exists(config_.recording.dir, ec) && !fs::is_directory(config_.recording.dir, ec)) {
+      spdlog::error("{}: {}: not a folder", whereIs("recording.dir"),
+                    config_.recording.dir.string());
+      return kExitBadInput;
+    }
+    sim::addSimCamera(drivers::CameraRegistry::instance());  // drivers/ knows nothing of sim/
+    if (auto rig =
+            drivers::Rig::checkOptions(config_.cameras.rig, drivers::CameraRegistry::instance());
+        !rig) {
+      spdlog::error("{}: cameras: {}", sourceName(), rig.error().message);
       return kExitBadInput;
     }
     if (config_.pipeline.enabled) {
@@ -247,8 +316,29 @@ class Daemon {
         return kExitBadInput;
       }
       processor_.emplace(std::move(*processor));
+      if (std::error_code ec; !config_.outputs.dir.empty() && fs::exists(config_.outputs.dir, ec) &&
+                              !fs::is_directory(config_.outputs.dir, ec)) {
+        spdlog::error("{}: {}: not a folder", whereIs("outputs.dir"), config_.outputs.dir.string());
+        return kExitBadInput;
+      }
     }
+    if (config_.status.enabled) {
+      boost::system::error_code error;
+      boost::asio::ip::make_address(config_.status.address, error);
+      if (error) {
+        spdlog::error("{}: '{}': not an IP address", whereIs("status.address"),
+                      config_.status.address);
+        return kExitBadInput;
+      }
+    }
+    return kExitOk;
+  }
 
+  // Everything that can fail on bad input, before anything is written (checkStart, the status
+  // port, the cameras, the results and session folders), then the start.
+  int prepare() {
+    if (const int failed = checkStart(); failed != kExitOk)
+      return failed;
     AcquisitionOptions acquisition;
     acquisition.rig = config_.cameras.rig;
     acquisition.layout = config_.cameras.layout;
@@ -333,7 +423,6 @@ class Daemon {
                        .dump()
                 << std::endl;
     }
-    sim::addSimCamera(drivers::CameraRegistry::instance());  // drivers/ knows nothing of sim/
     auto created = Acquisition::create(acquisition, drivers::CameraRegistry::instance());
     if (!created) {
       spdlog::error("{}", created.error().message);
@@ -360,6 +449,14 @@ class Daemon {
     return config_.source.empty() ? std::string("configuration") : config_.source.string();
   }
 
+  // Where a value came from, for an error about it: the command-line flag that overrode it, or
+  // the configuration file and key ("--nmea", "run.yaml: replay.nmea").
+  std::string whereIs(const std::string& key) const {
+    if (const auto flag = options_.flags_for_keys.find(key); flag != options_.flags_for_keys.end())
+      return flag->second;
+    return sourceName() + ": " + key;
+  }
+
   // The sim cameras replay the recorded session's sets in order and wrap around when they run
   // out, so a session with fewer sets than the map has locations gives later plots earlier plots'
   // frames, and a torn last index line drops a set unseen: both are said before the run.
@@ -370,16 +467,17 @@ class Daemon {
     const std::size_t sets = replayed->sets().size();
     if (const auto& torn = replayed->tornLine()) {
       spdlog::warn(
-          "replay.session {}: index.jsonl:{}: torn last line ({} bytes) left out: {} sets "
+          "{} {}: index.jsonl:{}: torn last line ({} bytes) left out: {} sets "
           "are replayed",
-          config_.replay.session.string(), torn->line, torn->bytes, sets);
+          whereIs("replay.session"), config_.replay.session.string(), torn->line, torn->bytes,
+          sets);
     }
     if (!map_.empty() && sets < map_.size()) {
       spdlog::warn(
-          "replay.session {}: {} sets for the map's {} locations: from trigger {} on, "
+          "{} {}: {} sets for the map's {} locations: from trigger {} on, "
           "the sim cameras replay earlier sets' frames again (those plots' traits are "
           "not their own)",
-          config_.replay.session.string(), sets, map_.size(), sets + 1);
+          whereIs("replay.session"), config_.replay.session.string(), sets, map_.size(), sets + 1);
     }
   }
 
@@ -420,8 +518,12 @@ class Daemon {
           *state = kMissed;
           current_row_ = rowOf(planner_alarm.location_id);
         }
-      } else {
+      } else if (planner_alarm.kind == gps::AlarmKind::kTooFast) {
         ++too_fast_;
+      } else if (planner_alarm.kind == gps::AlarmKind::kPositionJump) {
+        ++position_jumps_;
+      } else if (planner_alarm.kind == gps::AlarmKind::kTimeJump) {
+        ++time_jumps_;
       }
     }
     alarm(std::string(gps::toString(planner_alarm.kind)), planner_alarm.message,
@@ -487,10 +589,14 @@ class Daemon {
   }
 
   // Virtual time: the planner in GPS time, every trigger once the pipeline has room.
-  void runVirtualTime(const fs::path& nmea_path) {
+  void runVirtualTime() {
     boost::asio::io_context control;
     boost::asio::signal_set signals(control, SIGINT, SIGTERM, SIGHUP);
-    watchSignals(signals, [this] { acquisition_->interruptWaits(); });
+    // The input is ended too: a FIFO whose writer stays open would keep the replay reading.
+    watchSignals(signals, [this] {
+      acquisition_->interruptWaits();
+      replay_input_->interrupt();
+    });
     notifier_.startWatchdog(control);
     std::thread control_thread([&control] { control.run(); });
     // Stopped and joined on every way out: an exception from the replay (std::bad_alloc in a
@@ -507,7 +613,6 @@ class Daemon {
     } stop_and_join{control, control_thread};
     notifier_.ready();
 
-    std::ifstream nmea(nmea_path, std::ios::binary);
     // Processing takes as many sets as its queue holds; without processing, half the pool.
     const std::uint64_t room = processor_
                                    ? std::max<std::size_t>(1, config_.pipeline.queue_sets)
@@ -526,13 +631,17 @@ class Daemon {
       onTrigger(event);
     };
     handlers.on_alarm = [this](const gps::PlannerAlarm& a) { onPlannerAlarm(a); };
-    const auto summary = gps::replayTriggers(nmea, map_, config_.gps.triggers, handlers);
+    const auto summary =
+        gps::replayTriggers(replay_input_->stream(), map_, config_.gps.triggers, handlers);
     if (summary) {
       nmea_stats_ = summary->nmea;
       planner_stats_ = summary->planner;
     } else {
       spdlog::error("{}: {}", sourceName(), summary.error().message);
+      run_failed_ = true;
     }
+    if (!replay_input_->readError().empty())
+      nmea_problem_ = replay_input_->readError();
   }
 
   // Real time: the serial path of the field, from a device, or from a file played into a pty.
@@ -550,6 +659,7 @@ class Daemon {
       if (!started) {
         spdlog::error("{}", started.error().message);
         stop_requested_ = true;
+        run_failed_ = true;
         return;
       }
       player = std::move(*started);
@@ -566,6 +676,7 @@ class Daemon {
         [this](const gps::SerialStatus& status) { onSerial(status); });
     if (!created) {
       spdlog::error("{}: gps: {}", sourceName(), created.error().message);
+      run_failed_ = true;
       return;
     }
     gps::SerialTriggerChain& chain = *created;
@@ -611,6 +722,7 @@ class Daemon {
           }
           spdlog::info("signal {}: finishing the set in flight, then closing the session", number);
           notifier_.stopping();
+          stopped_by_signal_ = true;
           stop_requested_ = true;
           on_stop();
         });
@@ -782,10 +894,16 @@ class Daemon {
                     {"late", row.late},
                     {"missed", row.missed}};
     }
-    out["triggers"] = {{"fired", triggers_},  {"late", late_},
-                       {"missed", missed_},   {"too_fast", too_fast_},
-                       {"refused", refused_}, {"locations", map_.size()},
-                       {"rows", rows},        {"missed_locations", missed_locations_}};
+    out["triggers"] = {{"fired", triggers_},
+                       {"late", late_},
+                       {"missed", missed_},
+                       {"too_fast", too_fast_},
+                       {"position_jumps", position_jumps_},
+                       {"time_jumps", time_jumps_},
+                       {"refused", refused_},
+                       {"locations", map_.size()},
+                       {"rows", rows},
+                       {"missed_locations", missed_locations_}};
     if (last_trigger_) {
       out["triggers"]["last"] = {{"location", last_trigger_->location_id},
                                  {"time", core::formatIso8601(last_trigger_->time, 3)},
@@ -854,6 +972,8 @@ class Daemon {
     summary["triggers"] = acquisition_->triggered();
     summary["triggers_late"] = late_;
     summary["missed"] = missed_;
+    summary["position_jumps"] = planner_stats_.position_jumps;
+    summary["time_jumps"] = planner_stats_.time_jumps;
     summary["sets_recorded"] = stats.sets_recorded;
     summary["sets_incomplete"] = stats.rig.incomplete_sets;
     summary["sets_lost"] = stats.sets_lost;
@@ -866,6 +986,10 @@ class Daemon {
         link.counts_merged_triggers ? Json(link.triggers_merged) : Json(nullptr);
     summary["recording_stopped"] = stats.recording_stopped;
     summary["alarms"] = alarms_total_;
+    summary["nmea"] = {{"lines", nmea_stats_.lines},
+                       {"sentences", nmea_stats_.sentences},
+                       {"rejected_lines", nmea_stats_.rejectedTotal()},
+                       {"valid_fixes", planner_stats_.valid_epochs}};
     // How the run went on this machine (not results: they vary from run to run).
     const double elapsed_s = std::chrono::duration<double>(Clock::now() - started_at_).count();
     summary["elapsed_s"] = elapsed_s;
@@ -898,6 +1022,41 @@ class Daemon {
       spdlog::error("recording stopped: {}", stats.alarm);
       return kExitRuntime;
     }
+    if (!nmea_problem_.empty()) {
+      spdlog::error("{}: {}", whereIs("replay.nmea"), nmea_problem_);
+      return kExitRuntime;
+    }
+    if (run_failed_)
+      return kExitRuntime;  // said when it failed; the NMEA was never read
+    return judgeReplayedNmea();
+  }
+
+  // A replayed file that gave no fix would otherwise end as an empty session with exit 0: said
+  // as bad input, with what the lines were. Lines rejected beside good fixes are warned about.
+  int judgeReplayedNmea() const {
+    if (options_.mode != Mode::kReplay)
+      return kExitOk;
+    std::string rejected;
+    for (std::size_t i = 0; i < gps::kRejectReasonCount; ++i) {
+      if (const std::uint64_t count = nmea_stats_.rejected[i]; count > 0) {
+        rejected += (rejected.empty() ? "" : ", ") +
+                    std::string(gps::toString(static_cast<gps::RejectReason>(i))) + " " +
+                    std::to_string(count);
+      }
+    }
+    const std::string lines =
+        std::to_string(nmea_stats_.lines) + " lines (" + std::to_string(nmea_stats_.sentences) +
+        " sentences with a correct checksum, " + std::to_string(nmea_stats_.rejectedTotal()) +
+        " rejected" + (rejected.empty() ? "" : ": " + rejected) + ")";
+    if (planner_stats_.valid_epochs == 0 && !stopped_by_signal_) {
+      spdlog::error("{}: {}: no valid fix in {}: nothing could be triggered",
+                    whereIs("replay.nmea"), config_.replay.nmea.string(), lines);
+      return kExitBadInput;
+    }
+    if (nmea_stats_.rejectedTotal() > 0) {
+      spdlog::warn("{}: {}: lines rejected: {} of {}", whereIs("replay.nmea"),
+                   config_.replay.nmea.string(), nmea_stats_.rejectedTotal(), lines);
+    }
     return kExitOk;
   }
 
@@ -918,12 +1077,18 @@ class Daemon {
   Clock::time_point started_at_ = Clock::now();
   Clock::time_point last_status_notify_{};
   gps::NmeaStats nmea_stats_;
+  // Replay in virtual time: the NMEA file, opened by checkStart() and ended early by a signal.
+  std::unique_ptr<core::InterruptibleInput> replay_input_;
+  std::string nmea_problem_;  // a read error of the replayed file
+  std::atomic<bool> stopped_by_signal_{false};
+  bool run_failed_ = false;  // the GPS input could not be started: exit 3
   gps::TriggerStats planner_stats_;
 
   // Health: written by the GPS and processing threads, read by the status thread.
   mutable std::mutex health_mutex_;
   std::map<std::string, RowCounts> rows_;
   std::uint64_t triggers_ = 0, late_ = 0, missed_ = 0, too_fast_ = 0, refused_ = 0, fixes_ = 0;
+  std::uint64_t position_jumps_ = 0, time_jumps_ = 0;
   std::vector<std::string> missed_locations_;
   std::string location_states_;  // one of kPending… per location of the map, in its order
   std::string current_row_;      // the row of the latest trigger or missed location

@@ -11,14 +11,11 @@
 #include <new>
 #include <string>
 
-#include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/config/config.h"
 #include "fieldrig/core/command_line.h"
 #include "fieldrig/core/exception_message.h"
 #include "fieldrig/core/logging.h"
 #include "fieldrig/daemon/daemon.h"
-#include "fieldrig/daemon/head_frames.h"
-#include "fieldrig/gps/location_map.h"
 
 namespace {
 
@@ -42,40 +39,24 @@ std::string logFileProblem(const std::string& config_path, const fieldrig::confi
   return {};
 }
 
-// The configuration and the files it names, as the daemon would load them at start.
+// The configuration and the files it names, by the start's own checks (runDaemon with
+// check_only): what --check-config passes, the start does not refuse for the configuration.
 int checkConfig(const std::string& path) {
   auto loaded = fieldrig::config::loadConfig(path);
   if (!loaded) {
     std::cerr << "fieldrigd: " << loaded.error().message << '\n';
     return kExitBadInput;
   }
-  const fieldrig::config::Config& config = *loaded;
-  if (const std::string problem = logFileProblem(path, config); !problem.empty()) {
+  fieldrig::daemon::DaemonOptions options;
+  options.config = std::move(*loaded);
+  options.check_only = true;
+  if (const std::string problem = logFileProblem(path, options.config); !problem.empty()) {
     std::cerr << "fieldrigd: " << problem << '\n';
     return kExitBadInput;
   }
-  if (!config.map.empty()) {
-    if (auto map = fieldrig::gps::LocationMap::load(config.map); !map) {
-      std::cerr << "fieldrigd: " << map.error().message << '\n';
-      return kExitBadInput;
-    }
-  }
-  if (config.pipeline.enabled && !config.calibration.empty()) {
-    auto rig = fieldrig::cloud::loadRigCalibration(config.calibration);
-    if (!rig) {
-      std::cerr << "fieldrigd: " << rig.error().message << '\n';
-      return kExitBadInput;
-    }
-    if (auto cameras =
-            fieldrig::daemon::checkCalibratedHeadsHaveCameras(*rig, config.cameras.layout);
-        !cameras) {
-      std::cerr << "fieldrigd: " << path << ": " << cameras.error().message << " (calibration "
-                << config.calibration.string() << ")\n";
-      return kExitBadInput;
-    }
-  }
-  std::cout << path << ": ok\n";
-  return kExitOk;
+  // To stderr only: a check before the start (systemd's ExecStartPre) is not the run's log.
+  fieldrig::core::setupLogging(options.config.log.level, "");
+  return fieldrig::daemon::runDaemon(options);
 }
 
 // `logging_ready` is set once the log (stderr and the configured file) is set up.
@@ -83,7 +64,8 @@ int runMain(int argc, char** argv, bool& logging_ready) {
   CLI::App app{"fieldrigd: GPS-triggered stereo capture, recording and plot traits on the tractor"};
   app.footer(
       "Exit codes: 0 done (signal or end of replay); 2 bad configuration, option or input at "
-      "start (nothing written); 3 a failure while running; 4 internal error (an unexpected "
+      "start (nothing written), or a replayed NMEA input with no valid fix (its empty session "
+      "stays); 3 a failure while running; 4 internal error (an unexpected "
       "exception, out of memory; the session is closed first).");
   std::string check_config;
   app.add_option("--check-config", check_config,
@@ -149,24 +131,37 @@ int runMain(int argc, char** argv, bool& logging_ready) {
     return kExitBadInput;
   }
   fieldrig::config::Config& config = *loaded;
+  auto& flags = options.flags_for_keys;
   if (!log_level.empty())
     config.log.level = log_level;
-  if (!recording.empty())
+  if (!recording.empty()) {
     config.recording.dir = recording;
-  if (!map.empty())
+    flags["recording.dir"] = "--recording";
+  }
+  if (!map.empty()) {
     config.map = map;
-  if (!calibration.empty())
+    flags["map"] = "--map";
+  }
+  if (!calibration.empty()) {
     config.calibration = calibration;
+    flags["calibration"] = "--calibration";
+  }
   if (status_port >= 0)
     config.status.port = static_cast<std::uint16_t>(status_port);
-  if (!status_address.empty())
+  if (!status_address.empty()) {
     config.status.address = status_address;
+    flags["status.address"] = "--status-address";
+  }
   if (no_status)
     config.status.enabled = false;
-  if (!nmea.empty())
+  if (!nmea.empty()) {
     config.replay.nmea = nmea;
-  if (!session.empty())
+    flags["replay.nmea"] = "--nmea";
+  }
+  if (!session.empty()) {
     config.replay.session = session;
+    flags["replay.session"] = "--session";
+  }
   if (realtime)
     config.replay.realtime = true;
   options.print_results = !quiet;

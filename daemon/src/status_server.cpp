@@ -90,6 +90,12 @@ const std::vector<AlarmGuideEntry>& alarmGuide() {
       {"too_fast",
        "two locations came closer in time than the cameras' fastest rate: a trigger was delayed",
        "slow down; `speed.level` turns `warn` at 80 % of the limit"},
+      {"position_jump",
+       "the receiver's position leapt further than the tractor can move (a glitch of its "
+       "solution): plots between the two positions are neither triggered nor listed as missed",
+       "check the plots around the jump in the results; watch the RTK status"},
+      {"time_jump", "GPS time went back by more than 2 s: the track started over",
+       "check the receiver's date and time; triggering resumes by itself"},
       {"recording_stopped",
        "the disk is full or failing: nothing more is recorded; what was recorded is whole",
        "swap or clear the disk, then restart the daemon"},

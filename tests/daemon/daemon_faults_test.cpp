@@ -105,16 +105,18 @@ TEST_F(DaemonFaults, AMissingCalibrationIsNamedAndNothingIsWritten) {
   EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a bad calibration wrote something";
 }
 
-// A folder as the NMEA input read as no fixes at all: an empty session and exit 0.
+// A folder as the NMEA input used to read as no fixes at all (an empty session and exit 0). Given
+// on the command line, the error blamed the configuration file; it names the flag.
 TEST_F(DaemonFaults, AnNmeaFolderIsNamedAndNothingIsWritten) {
   ScopedTempDir dir("daemon_nmea_folder");
   const fs::path config = writeReplayConfig(dir.path(), "run", field_);
   const auto run =
       runDaemon({"replay", "--config", config.string(), "--nmea", field_.string()}, dir.path());
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_NE(run.err.find("replay.nmea: " + field_.string() + ": a folder, not an NMEA file"),
+  EXPECT_NE(run.err.find("--nmea: " + field_.string() + ": a folder, not an NMEA file"),
             std::string::npos)
       << run.err;
+  EXPECT_EQ(run.err.find(config.string()), std::string::npos) << run.err;
   EXPECT_FALSE(fs::exists(dir.path() / "run")) << "a folder as NMEA wrote something";
 }
 
@@ -178,6 +180,117 @@ TEST_F(DaemonFaults, AReplayedSessionWithATornLastLineIsSaidAndSoAreTheWrappedPl
       << run.err;
 }
 
+// A pipe as the NMEA input (here the daemon's stdin) whose writer stays open, as a logger's
+// would: SIGTERM was logged and then did nothing until the writer closed.
+TEST_F(DaemonFaults, SigtermEndsAReplayFromAPipeWhoseWriterStaysOpen) {
+  ScopedTempDir dir("daemon_nmea_pipe");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  FieldrigProcess daemon(
+      {"replay", "--config", config.string(), "--nmea", "/dev/stdin", "--no-status"}, dir.path(),
+      testing_support::kFieldrigdBinary);
+  const std::string drive = readWholeFile(field_ / "drive.nmea");
+  // Half the drive; the pipe stays open, so the replay waits for more.
+  ASSERT_TRUE(daemon.sendInput(drive.substr(0, drive.find('\n', drive.size() / 2) + 1)));
+  ASSERT_TRUE(daemon.waitForStdoutLines(1, 60s)) << daemon.err();
+  ASSERT_TRUE(daemon.signal(SIGTERM));
+  ASSERT_EQ(daemon.waitExit(30s), 0) << "the signal did not end the read\n" << daemon.err();
+  const Json summary = summaryOf(daemon.outLines());
+  ASSERT_FALSE(summary.is_null()) << daemon.out();
+  EXPECT_GT(summary.at("triggers").get<int>(), 0) << summary.dump();
+  EXPECT_EQ(summary.at("sets_recorded"), summary.at("triggers")) << summary.dump();
+  const auto verify = runFieldrig(
+      {"session", "info", (dir.path() / "run" / "session").string(), "--verify"}, dir.path());
+  EXPECT_EQ(verify.exit_code, 0) << verify.err;
+}
+
+// A file with no valid fix (garbage, bad checksums, only status V) replayed to an empty session
+// with exit 0 and no word; lines rejected beside good fixes were counted nowhere.
+TEST_F(DaemonFaults, AnNmeaFileWithNoValidFixIsBadInputAndRejectedLinesAreCounted) {
+  ScopedTempDir dir("daemon_nmea_no_fix");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  const fs::path garbage = dir.path() / "garbage.nmea";
+  std::ofstream(garbage) << "hello tractor\n$GPRMC,bad*00\n"
+                         << "$GPRMC,120000.00,V,,,,,,,140726,,,N*78\n";
+  const auto run =
+      runDaemon({"replay", "--config", config.string(), "--nmea", garbage.string(), "--no-status"},
+                dir.path());
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_NE(run.err.find("--nmea: " + garbage.string() + ": no valid fix in 3 lines"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("2 rejected"), std::string::npos) << run.err;
+  const Json summary = summaryOf(run.out_lines);
+  ASSERT_FALSE(summary.is_null()) << run.err;
+  EXPECT_EQ(summary.at("nmea").at("lines"), 3) << summary.dump();
+  EXPECT_EQ(summary.at("nmea").at("rejected_lines"), 2) << summary.dump();
+  EXPECT_EQ(summary.at("nmea").at("valid_fixes"), 0) << summary.dump();
+
+  // Three damaged lines inside the good drive: the run goes on, and says so.
+  const fs::path damaged = dir.path() / "damaged.nmea";
+  std::ofstream(damaged) << "$GPRMC,bad*00\nnoise\n\x01\x02\n"
+                         << readWholeFile(field_ / "drive.nmea");
+  const auto good = runDaemon({"replay", "--config", config.string(), "--nmea", damaged.string(),
+                               "--recording", (dir.path() / "second").string(), "--no-status"},
+                              dir.path());
+  EXPECT_EQ(good.exit_code, 0) << good.err;
+  const Json good_summary = summaryOf(good.out_lines);
+  ASSERT_FALSE(good_summary.is_null()) << good.err;
+  EXPECT_EQ(good_summary.at("nmea").at("rejected_lines"), 3) << good_summary.dump();
+  EXPECT_GT(good_summary.at("nmea").at("valid_fixes").get<int>(), 0) << good_summary.dump();
+  EXPECT_NE(good.err.find("lines rejected: 3 of"), std::string::npos) << good.err;
+}
+
+// --check-config kept a list of checks of its own and passed configurations that the start then
+// refused. It now runs the start's own checks: each of these is refused by both, naming the key
+// or file, and neither writes anything.
+TEST_F(DaemonFaults, CheckConfigRefusesWhatTheStartRefuses) {
+  ScopedTempDir dir("daemon_check_agrees");
+  const fs::path a_file = dir.path() / "a-file";
+  std::ofstream(a_file) << "not a folder\n";
+  const fs::path header_only_map = dir.path() / "header-only.csv";
+  {
+    const std::string map = readWholeFile(field_ / "map.csv");
+    std::ofstream(header_only_map) << map.substr(0, map.find('\n') + 1);
+  }
+  const std::string good = readWholeFile(writeReplayConfig(dir.path(), "run", field_));
+  auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? text : text.replace(at, from.size(), to);
+  };
+  const std::string map_line = "map: " + (field_ / "map.csv").string() + "\n";
+  const struct {
+    std::string name, config, named;
+  } cases[] = {
+      {"address", replaced("  port: 0\n", "  port: 0\n  address: not-an-ip\n"),
+       "status.address: 'not-an-ip'"},
+      {"no_map", replaced(map_line, "map: \"\"\n"), "map: no imaging-location map"},
+      {"header_map", replaced(map_line, "map: " + header_only_map.string() + "\n"),
+       header_only_map.string() + ": the map has no locations"},
+      {"no_recording", replaced("  dir: run/session\n", "  dir: \"\"\n"), "recording.dir"},
+      {"outputs_file", good + "outputs:\n  dir: " + a_file.string() + "\n",
+       "outputs.dir: " + a_file.string() + ": not a folder"},
+      {"recording_file", replaced("  dir: run/session\n", "  dir: " + a_file.string() + "\n"),
+       "recording.dir: " + a_file.string() + ": not a folder"},
+      {"huge_pool",
+       replaced("cameras:\n", "cameras:\n  pool_sets: 1024\n  width: 16384\n  height: 16384\n"),
+       "need more than this machine's"},
+  };
+  for (const auto& c : cases) {
+    const fs::path config = dir.path() / (c.name + ".yaml");
+    std::ofstream(config) << c.config;
+    const auto check = runDaemon({"--check-config", config.string()}, dir.path());
+    EXPECT_EQ(check.exit_code, 2) << c.name << "\n" << check.err;
+    EXPECT_NE(check.err.find(c.named), std::string::npos) << c.name << "\n" << check.err;
+    EXPECT_EQ(check.err.find(": ok"), std::string::npos) << c.name;
+    const auto start = runDaemon({"replay", "--config", config.string()}, dir.path());
+    EXPECT_EQ(start.exit_code, 2) << c.name << "\n" << start.err;
+    EXPECT_NE(start.err.find(c.named), std::string::npos) << c.name << "\n" << start.err;
+    EXPECT_FALSE(fs::exists(dir.path() / "run")) << c.name << " wrote something";
+  }
+}
+
 // Cameras for a head the calibration does not have, and none for one it has: every plot went
 // without that head, with exit 0 and an --check-config that said ok.
 TEST_F(DaemonFaults, ACalibratedHeadWithoutCamerasIsNamedAndNothingIsWritten) {
@@ -209,6 +322,9 @@ TEST_F(DaemonFaults, AnUnknownCameraDriverIsNamedWithTheDriversItHasSimIncluded)
   const auto run = runDaemon({"replay", "--config", config.string()}, dir.path());
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("unknown camera driver 'gige'"), std::string::npos) << run.err;
+  const auto check = runDaemon({"--check-config", config.string()}, dir.path());
+  EXPECT_EQ(check.exit_code, 2) << check.err;
+  EXPECT_NE(check.err.find("unknown camera driver 'gige'"), std::string::npos) << check.err;
   // fieldrigd added the sim driver (drivers/ does not know it): the error lists it.
   const auto listed = run.err.find("this build has: ");
   ASSERT_NE(listed, std::string::npos) << run.err;

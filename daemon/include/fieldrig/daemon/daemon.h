@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 
 #include "fieldrig/config/config.h"
@@ -32,11 +33,18 @@ struct DaemonOptions {
   config::Config config;
   Mode mode = Mode::kRun;
   bool print_results = true;  // one JSON line per plot on stdout (the summary line always)
+  // --check-config: run the start's checks of the configuration and what it names, print
+  // "SOURCE: ok" or the error, write nothing.
+  bool check_only = false;
+  // Keys whose value a command-line flag set, and the flag ("replay.nmea" -> "--nmea"): an error
+  // about such a value names the flag, not the configuration file.
+  std::map<std::string, std::string> flags_for_keys;
 };
 
 // Exit codes: 0 done (signal or end of replay), 2 bad configuration, option or input at start
-// (nothing written), 3 a failure while running, 4 an internal error (an exception nothing
-// handled, out of memory: fieldrigd_main logs it; the session was closed while unwinding).
+// (nothing written), or a replayed NMEA input that gave no valid fix (its empty session stays),
+// 3 a failure while running, 4 an internal error (an exception nothing handled, out of memory:
+// fieldrigd_main logs it; the session was closed while unwinding).
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitRuntime = 3;
