@@ -537,6 +537,10 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
     s.restartTrack();
     s.origin = fix.time;
     s.last_planned_position.reset();
+    // The cameras' minimum interval is kept in GPS time: a trigger time from before the jump
+    // lies ahead of every new plan and would hold (then drop as stale) each one until GPS time
+    // caught up again, every location meanwhile reported missed.
+    s.last_trigger_time.reset();
   }
   s.last_fix_time = fix.time;
   if (!s.origin)

@@ -57,6 +57,7 @@ struct Drive {
   core::UtcTime start = kStart;
   std::function<bool(int)> valid = [](int) { return true; };
   std::function<bool(int)> present = [](int) { return true; };
+  std::function<double(int)> east_offset = [](int) { return 0.0; };  // a receiver's glitch
 };
 
 std::vector<core::TriggerEvent> drive(const Field& field, TriggerPlanner& planner, const Drive& d) {
@@ -69,7 +70,7 @@ std::vector<core::TriggerEvent> drive(const Field& field, TriggerPlanner& planne
     if (!d.present(k))
       continue;
     const double north = d.north_start + d.direction * d.speed * 0.1 * k;
-    planner.addFix(field.fixAt(t, d.east, north, d.valid(k)), t);
+    planner.addFix(field.fixAt(t, d.east + d.east_offset(k), north, d.valid(k)), t);
     for (auto& e : planner.collectDue(t))
       all.push_back(e);
   }
@@ -260,6 +261,28 @@ TEST(TriggerPlannerTest, RecoversFromAJumpBackInTime) {
   EXPECT_EQ(toString(alarms[0].kind), "time_jump");
 }
 
+// GPS time goes back 10 s mid-row and runs on from there: every location after the jump still
+// fires. The trigger before the jump used to hold every later plan until GPS time caught up.
+TEST(TriggerPlannerTest, TriggeringGoesOnAfterGpsTimeJumpsBack) {
+  Field field;
+  for (int i = 0; i < 8; ++i)
+    field.addLocation("P" + std::to_string(i), 0.0, 1.3 + 3.7 * i);
+  TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
+  std::vector<std::string> fired;
+  for (int k = 0; k <= 200; ++k) {  // north -10 … 30 m at 2 m/s
+    // From k = 90 (north 8 m, after P0–P2) the receiver's time is 10 s earlier.
+    const core::UtcTime t = kStart + k * 100ms - (k >= 90 ? 10s : 0s);
+    for (auto& e : planner.collectDue(t - 1ns))
+      fired.push_back(e.location_id);
+    planner.addFix(field.fixAt(t, 0.0, -10.0 + 0.2 * k), t);
+    for (auto& e : planner.collectDue(t))
+      fired.push_back(e.location_id);
+  }
+  EXPECT_EQ(fired, (std::vector<std::string>{"P0", "P1", "P2", "P3", "P4", "P5", "P6", "P7"}));
+  EXPECT_EQ(planner.stats().time_jumps, 1u);
+  EXPECT_EQ(planner.stats().missed, 0u);
+}
+
 TEST(TriggerPlannerTest, APositionJumpAwayAndBackBlamesNoTriggeredLocation) {
   Field field;
   for (int i = 0; i < 5; ++i)
@@ -267,17 +290,10 @@ TEST(TriggerPlannerTest, APositionJumpAwayAndBackBlamesNoTriggeredLocation) {
   TriggerPlanner planner = TriggerPlanner::create(field.map(), {}).value();
   // North at 2 m/s from -10 m; for 0.8 s (north 6.0 to 7.6 m, after P0 and P1 fired, before P2)
   // the receiver reports a solution 2 km east, moving on as the tractor does.
-  std::vector<core::TriggerEvent> events;
-  for (int k = 0; k <= 150; ++k) {
-    const core::UtcTime t = kStart + k * 100ms;
-    for (auto& e : planner.collectDue(t - 1ns))
-      events.push_back(e);
-    const double north = -10.0 + 0.2 * k;
-    const double east = (k >= 80 && k < 88) ? 2000.0 : 0.0;
-    planner.addFix(field.fixAt(t, east, north), t);
-    for (auto& e : planner.collectDue(t))
-      events.push_back(e);
-  }
+  Drive d;
+  d.duration_s = 15;
+  d.east_offset = [](int k) { return (k >= 80 && k < 88) ? 2000.0 : 0.0; };
+  const auto events = drive(field, planner, d);
   ASSERT_EQ(events.size(), 5u);
   for (int i = 0; i < 5; ++i)
     EXPECT_EQ(events[i].location_id, "P" + std::to_string(i));
