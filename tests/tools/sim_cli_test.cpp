@@ -68,6 +68,24 @@ TEST_F(SimCliTest, AnOutputThatCannotBeWrittenIsBadInputNamingIt) {
   EXPECT_NE(run.err.find(unwritable.string()), std::string::npos) << run.err;
   EXPECT_FALSE(fs::exists(unwritable.parent_path()));
   EXPECT_FALSE(fs::exists(dir_ / "drive.nmea")) << "a drive was left without its map";
+
+  // A folder as the map, or one file for both: refused before anything is written (the drive
+  // was written beside no map, or the map overwrote it).
+  fs::create_directories(dir_ / "a-folder");
+  const std::vector<std::pair<std::string, std::string>> outputs = {
+      {(dir_ / "drive.nmea").string(), (dir_ / "a-folder").string()},
+      {(dir_ / "both").string(), (dir_ / "both").string()}};
+  for (const auto& [nmea, map] : outputs) {
+    const auto refused =
+        runFieldrig({"sim", "drive", "--row-start", "42.0106,-93.7385", "--row-end",
+                     "42.0112,-93.7385", "--rows", "2", "--plot-length", "3", "--alley-length", "1",
+                     "--row-spacing", "2.286", "--out-nmea", nmea, "--out-map", map},
+                    dir_);
+    EXPECT_EQ(refused.exit_code, 2) << map << "\n" << refused.err;
+    EXPECT_NE(refused.err.find(map), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(dir_ / "drive.nmea")) << map;
+    EXPECT_FALSE(fs::exists(dir_ / "both")) << map;
+  }
 }
 
 // The speed profile, correlated noise and velocity noise reach the NMEA: RMC speeds breathe

@@ -58,6 +58,18 @@ int runDrive(const DriveArgs& args) {
     const fs::file_status status = fs::symlink_status(path, ec);
     return status.type() == fs::file_type::not_found || status.type() == fs::file_type::regular;
   };
+  std::error_code same_error;
+  if (args.out_nmea == args.out_map ||
+      fs::equivalent(args.out_nmea, args.out_map, same_error)) {  // the drive would be lost
+    std::cerr << kName << "--out-nmea and --out-map name the same file: " << args.out_map << '\n';
+    return kExitBadInput;
+  }
+  for (const std::string& out : {args.out_nmea, args.out_map}) {
+    if (std::error_code ec; fs::is_directory(out, ec)) {
+      std::cerr << kName << out << ": a folder, not a file; nothing was written\n";
+      return kExitBadInput;
+    }
+  }
   std::string failed;
   if (replaceable(args.out_nmea) && replaceable(args.out_map)) {
     failed = core::replaceFilesTogether({{args.out_nmea, nmea}, {args.out_map, csv}});
@@ -77,6 +89,13 @@ int runDrive(const DriveArgs& args) {
   summary["length_m"] = drive.lengthM();
   summary["start"] = core::formatIso8601(drive.start(), 2);
   summary["end"] = core::formatIso8601(drive.end(), 2);
+  // An output written to stdout keeps it to itself: the summary goes to stderr.
+  std::error_code ec;
+  if (fs::equivalent(args.out_nmea, "/dev/stdout", ec) ||
+      fs::equivalent(args.out_map, "/dev/stdout", ec)) {
+    std::cerr << summary.dump() << '\n';
+    return kExitOk;
+  }
   return printJsonLine(summary);
 }
 
