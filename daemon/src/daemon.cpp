@@ -12,6 +12,7 @@
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -142,6 +143,25 @@ double maxSpeedFor(const gps::LocationMap& map, double min_trigger_interval_s) {
   return std::isfinite(shortest) ? shortest / min_trigger_interval_s : 0;
 }
 
+// Outside the runs' own asio signal_sets (start-up, and closing once the NMEA has ended) the
+// default action of SIGTERM, SIGINT and SIGHUP would kill the daemon with the session open and
+// the results unwritten: a signal there is only remembered. (asio puts back the default action
+// when a signal_set goes, so this is installed again after each run.)
+std::atomic<int> g_signal_outside_runs{0};
+static_assert(std::atomic<int>::is_always_lock_free);  // set from a signal handler
+
+extern "C" void rememberSignal(int number) {
+  g_signal_outside_runs.store(number);
+}
+
+void rememberStopSignals() {
+  struct sigaction action {};
+  action.sa_handler = rememberSignal;
+  sigemptyset(&action.sa_mask);
+  for (const int number : {SIGINT, SIGTERM, SIGHUP})
+    ::sigaction(number, &action, nullptr);
+}
+
 class Daemon {
  public:
   explicit Daemon(const DaemonOptions& options) : options_(options), config_(options.config) {}
@@ -153,8 +173,16 @@ class Daemon {
         std::cout << sourceName() << ": ok" << std::endl;
       return failed;
     }
+    rememberStopSignals();
     if (const int failed = prepare(); failed != kExitOk)
       return failed;
+    if (const int number = g_signal_outside_runs.exchange(0);
+        number == SIGINT || number == SIGTERM) {
+      // Asked to stop while starting: nothing is triggered, the session is closed as usual.
+      spdlog::info("signal {} during start-up: closing the session", number);
+      stopped_by_signal_ = true;
+      return finish();
+    }
     const fs::path& nmea =
         options_.mode == Mode::kReplay ? config_.replay.nmea : fs::path(config_.gps.serial.device);
     std::error_code ec;
@@ -164,10 +192,62 @@ class Daemon {
     } else {
       runLive(nmea, /*play_file=*/!device);
     }
+    rememberStopSignals();
     return finish();
   }
 
  private:
+  // The session the sim cameras replay must be one, and the run must not record into it (it
+  // appended its sets to the session it was replaying).
+  int checkReplayedSession() const {
+    const bool replays_session = config_.cameras.rig.driver == "sim" &&
+                                 !config_.replay.session.empty() && checksReplayInputs();
+    if (!replays_session)
+      return kExitOk;
+    const auto replayed = recording::SessionReader::open(config_.replay.session);
+    if (!replayed) {
+      spdlog::error("{}: {}", whereIs("replay.session"), replayed.error().message);
+      return kExitBadInput;
+    }
+    if (replayed->sets().empty()) {
+      spdlog::error("{}: {}: no sets recorded to replay", whereIs("replay.session"),
+                    config_.replay.session.string());
+      return kExitBadInput;
+    }
+    std::error_code source_error, target_error;
+    const fs::path source = fs::weakly_canonical(config_.replay.session, source_error);
+    const fs::path target = fs::weakly_canonical(config_.recording.dir, target_error);
+    const bool inside =
+        std::mismatch(source.begin(), source.end(), target.begin(), target.end()).first ==
+        source.end();
+    if (!source_error && !target_error && inside) {
+      spdlog::error("{}: {}: inside the session being replayed ({}): record elsewhere",
+                    whereIs("recording.dir"), config_.recording.dir.string(),
+                    config_.replay.session.string());
+      return kExitBadInput;
+    }
+    return kExitOk;
+  }
+
+  // The path itself, or the nearest folder above it that exists, when that is not a folder
+  // (creating the folders would fail): nullopt when the path can be a folder.
+  static std::optional<fs::path> fileOnTheWay(const fs::path& path) {
+    std::error_code ec;
+    for (fs::path at = fs::absolute(path, ec); !ec; at = at.parent_path()) {
+      const fs::file_status status = fs::status(at, ec);
+      if (status.type() == fs::file_type::not_found) {
+        ec.clear();
+        if (at == at.parent_path())
+          break;
+        continue;
+      }
+      if (ec)
+        break;
+      return fs::is_directory(status) ? std::nullopt : std::optional<fs::path>(at);
+    }
+    return std::nullopt;
+  }
+
   // Replay of a file (not a device) in GPS time, as fast as the pipeline takes it.
   bool replaysInVirtualTime() const {
     std::error_code ec;
@@ -276,12 +356,13 @@ class Daemon {
       spdlog::error("{}: recording.dir: no session folder configured", sourceName());
       return kExitBadInput;
     }
-    if (std::error_code ec;
-        fs::exists(config_.recording.dir, ec) && !fs::is_directory(config_.recording.dir, ec)) {
-      spdlog::error("{}: {}: not a folder", whereIs("recording.dir"),
-                    config_.recording.dir.string());
+    if (const auto file = fileOnTheWay(config_.recording.dir)) {
+      spdlog::error("{}: {}: {} is not a folder", whereIs("recording.dir"),
+                    config_.recording.dir.string(), file->string());
       return kExitBadInput;
     }
+    if (const int failed = checkReplayedSession(); failed != kExitOk)
+      return failed;
     sim::addSimCamera(drivers::CameraRegistry::instance());  // drivers/ knows nothing of sim/
     if (auto rig =
             drivers::Rig::checkOptions(config_.cameras.rig, drivers::CameraRegistry::instance());
@@ -316,9 +397,10 @@ class Daemon {
         return kExitBadInput;
       }
       processor_.emplace(std::move(*processor));
-      if (std::error_code ec; !config_.outputs.dir.empty() && fs::exists(config_.outputs.dir, ec) &&
-                              !fs::is_directory(config_.outputs.dir, ec)) {
-        spdlog::error("{}: {}: not a folder", whereIs("outputs.dir"), config_.outputs.dir.string());
+      if (const auto file =
+              config_.outputs.dir.empty() ? std::nullopt : fileOnTheWay(config_.outputs.dir)) {
+        spdlog::error("{}: {}: {} is not a folder", whereIs("outputs.dir"),
+                      config_.outputs.dir.string(), file->string());
         return kExitBadInput;
       }
     }
@@ -413,15 +495,18 @@ class Daemon {
           config_.status.address, config_.status.port, [this] { return snapshot(); },
           std::move(status_options));
       if (!server) {
-        spdlog::error("{}", server.error().message);
+        spdlog::error("{}, {}: {}", whereIs("status.address"), whereIs("status.port"),
+                      server.error().message);
         return kExitBadInput;
       }
       status_ = std::move(*server);
-      spdlog::info("status on http://{}:{}/status", config_.status.address, status_->port());
-      std::cerr << Json{{"status_url", "http://" + config_.status.address + ":" +
-                                           std::to_string(status_->port()) + "/status"}}
-                       .dump()
-                << std::endl;
+      // An IPv6 address is bracketed in a URL (http://[::1]:8080/).
+      const std::string host = config_.status.address.find(':') == std::string::npos
+                                   ? config_.status.address
+                                   : "[" + config_.status.address + "]";
+      const std::string url = "http://" + host + ":" + std::to_string(status_->port()) + "/status";
+      spdlog::info("status on {}", url);
+      std::cerr << Json{{"status_url", url}}.dump() << std::endl;
     }
     auto created = Acquisition::create(acquisition, drivers::CameraRegistry::instance());
     if (!created) {
@@ -597,6 +682,11 @@ class Daemon {
       acquisition_->interruptWaits();
       replay_input_->interrupt();
     });
+    if (g_signal_outside_runs.exchange(0) != 0) {  // came before the signal_set took over
+      stopped_by_signal_ = true;
+      stop_requested_ = true;
+      replay_input_->interrupt();
+    }
     notifier_.startWatchdog(control);
     std::thread control_thread([&control] { control.run(); });
     // Stopped and joined on every way out: an exception from the replay (std::bad_alloc in a
@@ -686,6 +776,10 @@ class Daemon {
       io.stop();
     };
     watchSignals(signals, stop_all);
+    if (g_signal_outside_runs.exchange(0) != 0) {  // came before the signal_set took over
+      stopped_by_signal_ = true;
+      stop_requested_ = true;  // the housekeeping timer ends the run
+    }
     boost::asio::steady_timer housekeeping_timer(io);
     std::function<void()> arm = [&] {
       housekeeping_timer.expires_after(kHousekeepingPeriod);
@@ -959,6 +1053,7 @@ class Daemon {
 
   int finish() {
     notifier_.stopping();
+    spdlog::info("fieldrigd: closing the session (the sets in flight are finished and processed)");
     acquisition_->finish(kFinishTimeout);
     if (results_) {
       if (const std::string failed = results_->flush(); !failed.empty())
@@ -988,8 +1083,9 @@ class Daemon {
     summary["alarms"] = alarms_total_;
     summary["nmea"] = {{"lines", nmea_stats_.lines},
                        {"sentences", nmea_stats_.sentences},
-                       {"rejected_lines", nmea_stats_.rejectedTotal()},
-                       {"valid_fixes", planner_stats_.valid_epochs}};
+                       {"rejected_sentences", nmea_stats_.rejectedTotal()},
+                       {"valid_fixes", planner_stats_.valid_epochs},
+                       {"invalid_fixes", planner_stats_.fixes_invalid}};
     // How the run went on this machine (not results: they vary from run to run).
     const double elapsed_s = std::chrono::duration<double>(Clock::now() - started_at_).count();
     summary["elapsed_s"] = elapsed_s;
@@ -1047,14 +1143,27 @@ class Daemon {
     const std::string lines =
         std::to_string(nmea_stats_.lines) + " lines (" + std::to_string(nmea_stats_.sentences) +
         " sentences with a correct checksum, " + std::to_string(nmea_stats_.rejectedTotal()) +
-        " rejected" + (rejected.empty() ? "" : ": " + rejected) + ")";
+        " rejected" + (rejected.empty() ? "" : ": " + rejected) + ")" +
+        (planner_stats_.fixes > 0 && planner_stats_.valid_epochs == 0
+             ? "; every fix invalid (RMC status V or GGA quality 0, or vetoed by the other)"
+             : "");
     if (planner_stats_.valid_epochs == 0 && !stopped_by_signal_) {
       spdlog::error("{}: {}: no valid fix in {}: nothing could be triggered",
                     whereIs("replay.nmea"), config_.replay.nmea.string(), lines);
       return kExitBadInput;
     }
+    if (planner_stats_.fixes_invalid > 0 && acquisition_->triggered() < map_.size()) {
+      // Each invalid fix restarts the track: a receiver flickering between valid and invalid
+      // gives fixes but never a track, and no alarm would say why nothing fired.
+      spdlog::warn(
+          "{}: {}: {} of {} fixes were invalid (each restarts the track, {} restarts): "
+          "{} triggers for {} locations",
+          whereIs("replay.nmea"), config_.replay.nmea.string(), planner_stats_.fixes_invalid,
+          planner_stats_.fixes, planner_stats_.track_restarts, acquisition_->triggered(),
+          map_.size());
+    }
     if (nmea_stats_.rejectedTotal() > 0) {
-      spdlog::warn("{}: {}: lines rejected: {} of {}", whereIs("replay.nmea"),
+      spdlog::warn("{}: {}: sentences rejected: {} in {}", whereIs("replay.nmea"),
                    config_.replay.nmea.string(), nmea_stats_.rejectedTotal(), lines);
     }
     return kExitOk;

@@ -146,8 +146,10 @@ int runMain(int argc, char** argv, bool& logging_ready) {
     config.calibration = calibration;
     flags["calibration"] = "--calibration";
   }
-  if (status_port >= 0)
+  if (status_port >= 0) {
     config.status.port = static_cast<std::uint16_t>(status_port);
+    flags["status.port"] = "--status-port";
+  }
   if (!status_address.empty()) {
     config.status.address = status_address;
     flags["status.address"] = "--status-address";

@@ -222,7 +222,7 @@ TEST_F(DaemonFaults, AnNmeaFileWithNoValidFixIsBadInputAndRejectedLinesAreCounte
   const Json summary = summaryOf(run.out_lines);
   ASSERT_FALSE(summary.is_null()) << run.err;
   EXPECT_EQ(summary.at("nmea").at("lines"), 3) << summary.dump();
-  EXPECT_EQ(summary.at("nmea").at("rejected_lines"), 2) << summary.dump();
+  EXPECT_EQ(summary.at("nmea").at("rejected_sentences"), 2) << summary.dump();
   EXPECT_EQ(summary.at("nmea").at("valid_fixes"), 0) << summary.dump();
 
   // Three damaged lines inside the good drive: the run goes on, and says so.
@@ -235,9 +235,9 @@ TEST_F(DaemonFaults, AnNmeaFileWithNoValidFixIsBadInputAndRejectedLinesAreCounte
   EXPECT_EQ(good.exit_code, 0) << good.err;
   const Json good_summary = summaryOf(good.out_lines);
   ASSERT_FALSE(good_summary.is_null()) << good.err;
-  EXPECT_EQ(good_summary.at("nmea").at("rejected_lines"), 3) << good_summary.dump();
+  EXPECT_EQ(good_summary.at("nmea").at("rejected_sentences"), 3) << good_summary.dump();
   EXPECT_GT(good_summary.at("nmea").at("valid_fixes").get<int>(), 0) << good_summary.dump();
-  EXPECT_NE(good.err.find("lines rejected: 3 of"), std::string::npos) << good.err;
+  EXPECT_NE(good.err.find("sentences rejected: 3 in"), std::string::npos) << good.err;
 }
 
 // --check-config kept a list of checks of its own and passed configurations that the start then
@@ -270,9 +270,16 @@ TEST_F(DaemonFaults, CheckConfigRefusesWhatTheStartRefuses) {
        header_only_map.string() + ": the map has no locations"},
       {"no_recording", replaced("  dir: run/session\n", "  dir: \"\"\n"), "recording.dir"},
       {"outputs_file", good + "outputs:\n  dir: " + a_file.string() + "\n",
-       "outputs.dir: " + a_file.string() + ": not a folder"},
+       "outputs.dir: " + a_file.string() + ": " + a_file.string() + " is not a folder"},
       {"recording_file", replaced("  dir: run/session\n", "  dir: " + a_file.string() + "\n"),
-       "recording.dir: " + a_file.string() + ": not a folder"},
+       "recording.dir: " + a_file.string() + ": " + a_file.string() + " is not a folder"},
+      {"record_into_source",
+       replaced("  dir: run/session\n",
+                "  dir: " + (field_ / "source-session" / "run").string() + "\n"),
+       "inside the session being replayed"},
+      {"no_session", replaced("source-session\n", "no-such-session\n"), "replay.session: "},
+      {"under_a_file", replaced("  dir: run/session\n", "  dir: " + a_file.string() + "/sub\n"),
+       "recording.dir: " + a_file.string() + "/sub: " + a_file.string() + " is not a folder"},
       {"huge_pool",
        replaced("cameras:\n", "cameras:\n  pool_sets: 1024\n  width: 16384\n  height: 16384\n"),
        "need more than this machine's"},
@@ -387,6 +394,23 @@ TEST_F(DaemonFaults, SigtermMidRunFinishesTheSetInFlightAndClosesTheSession) {
   const auto verify = runFieldrig(
       {"session", "info", (dir.path() / "run" / "session").string(), "--verify"}, dir.path());
   EXPECT_EQ(verify.exit_code, 0) << verify.err;
+}
+
+// Once the NMEA has ended, the last sets are still processed and the results written: a SIGTERM
+// then took the default action (exit 143, no summary, the results behind the recording).
+TEST_F(DaemonFaults, SigtermWhileClosingStillFinishesTheResults) {
+  ScopedTempDir dir("daemon_sigterm_closing");
+  const fs::path config = writeReplayConfig(dir.path(), "run", field_);
+  FieldrigProcess daemon({"replay", "--config", config.string(), "--no-status"}, dir.path(),
+                         testing_support::kFieldrigdBinary);
+  ASSERT_TRUE(daemon.waitForStderr("closing the session", 120s)) << daemon.err();
+  daemon.signal(SIGTERM);  // false if it has already exited: then there is nothing to test
+  ASSERT_EQ(daemon.waitExit(60s), 0) << daemon.err();
+  const Json summary = summaryOf(daemon.outLines());
+  ASSERT_FALSE(summary.is_null()) << daemon.out();
+  EXPECT_EQ(summary.at("triggers"), 12) << summary.dump();
+  EXPECT_EQ(summary.at("sets_processed"), summary.at("sets_recorded")) << summary.dump();
+  EXPECT_EQ(plotLines(daemon.outLines()), 12U);
 }
 
 TEST_F(DaemonFaults, KillNineThenRestartVerifiesAndCarriesOnIntoTheSession) {
