@@ -28,6 +28,7 @@
 #include <optional>
 #include <thread>
 #include <tuple>
+#include <utility>
 
 #include "fieldrig/cloud/rig_calibration.h"
 #include "fieldrig/core/interruptible_input.h"
@@ -143,28 +144,11 @@ double maxSpeedFor(const gps::LocationMap& map, double min_trigger_interval_s) {
   return std::isfinite(shortest) ? shortest / min_trigger_interval_s : 0;
 }
 
-// Outside the runs' own asio signal_sets (start-up, and closing once the NMEA has ended) the
-// default action of SIGTERM, SIGINT and SIGHUP would kill the daemon with the session open and
-// the results unwritten: a signal there is only remembered. (asio puts back the default action
-// when a signal_set goes, so this is installed again after each run.)
-std::atomic<int> g_signal_outside_runs{0};
-static_assert(std::atomic<int>::is_always_lock_free);  // set from a signal handler
-
-extern "C" void rememberSignal(int number) {
-  g_signal_outside_runs.store(number);
-}
-
-void rememberStopSignals() {
-  struct sigaction action {};
-  action.sa_handler = rememberSignal;
-  sigemptyset(&action.sa_mask);
-  for (const int number : {SIGINT, SIGTERM, SIGHUP})
-    ::sigaction(number, &action, nullptr);
-}
-
 class Daemon {
  public:
-  explicit Daemon(const DaemonOptions& options) : options_(options), config_(options.config) {}
+  explicit Daemon(const DaemonOptions& options) : options_(options), config_(options.config) {
+    watchLifeSignals();
+  }
 
   int run() {
     if (options_.check_only) {
@@ -173,13 +157,11 @@ class Daemon {
         std::cout << sourceName() << ": ok" << std::endl;
       return failed;
     }
-    rememberStopSignals();
     if (const int failed = prepare(); failed != kExitOk)
       return failed;
-    if (const int number = g_signal_outside_runs.exchange(0);
-        number == SIGINT || number == SIGTERM) {
+    if (takeLifeSignals()) {
       // Asked to stop while starting: nothing is triggered, the session is closed as usual.
-      spdlog::info("signal {} during start-up: closing the session", number);
+      spdlog::info("a stop signal during start-up: closing the session");
       stopped_by_signal_ = true;
       return finish();
     }
@@ -192,11 +174,35 @@ class Daemon {
     } else {
       runLive(nmea, /*play_file=*/!device);
     }
-    rememberStopSignals();
     return finish();
   }
 
  private:
+  // The runs' own signal_sets (each with its run's way to stop) live only while they run, and
+  // asio puts back the default action of a signal when the last set holding it goes: a SIGTERM
+  // during start-up or while closing, after the NMEA ended, killed the daemon with the results
+  // behind the recording. This set holds the three signals for the daemon's whole life; its
+  // io_context is only polled, where a signal can be acted on.
+  void watchLifeSignals() {
+    life_signals_.async_wait([this](const boost::system::error_code& error, int number) {
+      if (error)
+        return;
+      if (number == SIGHUP) {
+        core::setupLogging(config_.log.level, config_.log.file.string());
+        spdlog::info("SIGHUP: log reopened");
+      } else {
+        life_stop_signals_ = true;
+      }
+      watchLifeSignals();
+    });
+  }
+  // True when SIGINT or SIGTERM came since the last call (SIGHUP reopens the log here too).
+  bool takeLifeSignals() {
+    life_io_.restart();
+    life_io_.poll();
+    return std::exchange(life_stop_signals_, false);
+  }
+
   // The session the sim cameras replay must be one, and the run must not record into it (it
   // appended its sets to the session it was replaying).
   int checkReplayedSession() const {
@@ -682,7 +688,8 @@ class Daemon {
       acquisition_->interruptWaits();
       replay_input_->interrupt();
     });
-    if (g_signal_outside_runs.exchange(0) != 0) {  // came before the signal_set took over
+    if (takeLifeSignals()) {  // came before this run's signal_set (or since, and seen by both)
+      spdlog::info("a stop signal before the replay began: closing the session");
       stopped_by_signal_ = true;
       stop_requested_ = true;
       replay_input_->interrupt();
@@ -776,9 +783,11 @@ class Daemon {
       io.stop();
     };
     watchSignals(signals, stop_all);
-    if (g_signal_outside_runs.exchange(0) != 0) {  // came before the signal_set took over
+    if (takeLifeSignals()) {  // came before this run's signal_set (or since, and seen by both)
+      spdlog::info("a stop signal before the run began: closing the session");
       stopped_by_signal_ = true;
-      stop_requested_ = true;  // the housekeeping timer ends the run
+      stop_requested_ = true;
+      boost::asio::post(io, stop_all);
     }
     boost::asio::steady_timer housekeeping_timer(io);
     std::function<void()> arm = [&] {
@@ -1054,7 +1063,13 @@ class Daemon {
   int finish() {
     notifier_.stopping();
     spdlog::info("fieldrigd: closing the session (the sets in flight are finished and processed)");
+    takeLifeSignals();  // the run's own set has seen those already
     acquisition_->finish(kFinishTimeout);
+    if (takeLifeSignals()) {
+      spdlog::info(
+          "a stop signal while closing: the session is closed whole and the results written "
+          "first, as they are now");
+    }
     if (results_) {
       if (const std::string failed = results_->flush(); !failed.empty())
         alarm("results_not_written", failed, "");
@@ -1190,7 +1205,10 @@ class Daemon {
   std::unique_ptr<core::InterruptibleInput> replay_input_;
   std::string nmea_problem_;  // a read error of the replayed file
   std::atomic<bool> stopped_by_signal_{false};
-  bool run_failed_ = false;  // the GPS input could not be started: exit 3
+  boost::asio::io_context life_io_;
+  boost::asio::signal_set life_signals_{life_io_, SIGINT, SIGTERM, SIGHUP};
+  bool life_stop_signals_ = false;  // of life_io_'s handler, run by takeLifeSignals()
+  bool run_failed_ = false;         // the GPS input could not be started: exit 3
   gps::TriggerStats planner_stats_;
 
   // Health: written by the GPS and processing threads, read by the status thread.

@@ -534,13 +534,14 @@ void TriggerPlanner::addFix(const core::GpsFix& fix, core::UtcTime now) {
          fmt::format("GPS time went back by {:.1f} s (a receiver glitch or a day boundary): the "
                      "track restarts from this fix",
                      core::toSeconds(*s.last_fix_time - fix.time))});
+    // The cameras' minimum interval is kept in GPS time: the trigger before the jump is moved
+    // back with it. Left where it was, it lay ahead of every new plan and held each one (then
+    // dropped it as stale) until GPS time caught up, every location meanwhile reported missed.
+    if (s.last_trigger_time)
+      *s.last_trigger_time -= *s.last_fix_time - fix.time;
     s.restartTrack();
     s.origin = fix.time;
     s.last_planned_position.reset();
-    // The cameras' minimum interval is kept in GPS time: a trigger time from before the jump
-    // lies ahead of every new plan and would hold (then drop as stale) each one until GPS time
-    // caught up again, every location meanwhile reported missed.
-    s.last_trigger_time.reset();
   }
   s.last_fix_time = fix.time;
   if (!s.origin)

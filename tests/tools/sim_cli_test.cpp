@@ -74,7 +74,7 @@ TEST_F(SimCliTest, AnOutputThatCannotBeWrittenIsBadInputNamingIt) {
   fs::create_directories(dir_ / "a-folder");
   const std::vector<std::pair<std::string, std::string>> outputs = {
       {(dir_ / "drive.nmea").string(), (dir_ / "a-folder").string()},
-      {(dir_ / "both").string(), (dir_ / "both").string()}};
+      {(dir_ / "both").string(), (dir_ / "." / "both").string()}};
   for (const auto& [nmea, map] : outputs) {
     const auto refused =
         runFieldrig({"sim", "drive", "--row-start", "42.0106,-93.7385", "--row-end",

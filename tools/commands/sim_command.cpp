@@ -58,11 +58,16 @@ int runDrive(const DriveArgs& args) {
     const fs::file_status status = fs::symlink_status(path, ec);
     return status.type() == fs::file_type::not_found || status.type() == fs::file_type::regular;
   };
-  std::error_code same_error;
-  if (args.out_nmea == args.out_map ||
-      fs::equivalent(args.out_nmea, args.out_map, same_error)) {  // the drive would be lost
-    std::cerr << kName << "--out-nmea and --out-map name the same file: " << args.out_map << '\n';
-    return kExitBadInput;
+  // One file for both would lose the drive. Devices (/dev/null, a terminal) are written through
+  // and may well be one.
+  if (replaceable(args.out_nmea) && replaceable(args.out_map)) {
+    std::error_code nmea_error, map_error;
+    const fs::path nmea_path = fs::weakly_canonical(args.out_nmea, nmea_error);
+    const fs::path map_path = fs::weakly_canonical(args.out_map, map_error);
+    if (!nmea_error && !map_error && nmea_path == map_path) {
+      std::cerr << kName << "--out-nmea and --out-map name the same file: " << args.out_map << '\n';
+      return kExitBadInput;
+    }
   }
   for (const std::string& out : {args.out_nmea, args.out_map}) {
     if (std::error_code ec; fs::is_directory(out, ec)) {
