@@ -138,14 +138,10 @@ int runMain(int argc, char** argv, bool& logging_ready) {
     config.recording.dir = recording;
     flags["recording.dir"] = "--recording";
   }
-  if (!map.empty()) {
-    config.map = map;
-    flags["map"] = "--map";
-  }
-  if (!calibration.empty()) {
+  if (!map.empty())
+    config.map = map;  // its loader's errors name the file itself
+  if (!calibration.empty())
     config.calibration = calibration;
-    flags["calibration"] = "--calibration";
-  }
   if (status_port >= 0) {
     config.status.port = static_cast<std::uint16_t>(status_port);
     flags["status.port"] = "--status-port";
